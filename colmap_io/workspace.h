@@ -1,0 +1,58 @@
+#pragma once
+
+// Discovery of a COLMAP workspace.
+//
+// A dense workspace (the output of `colmap image_undistorter`) has images/,
+// sparse/ (PINHOLE or SIMPLE_PINHOLE cameras, .bin or .txt), optionally
+// stereo/{depth_maps,normal_maps}/, fused.ply (+ .vis), meshed-poisson.ply,
+// meshed-delaunay.ply. A sparse workspace (a project folder with images/ and
+// sparse/0 in a distorted model) is undistorted first, into
+// <workspace>/mesh_refiner_undistorted/, which is then opened as a dense
+// workspace; the log says how.
+
+#include <string>
+#include <vector>
+
+#include <opencv2/core.hpp>
+
+#include "colmap_io/sparse_model.h"
+
+namespace mr {
+
+struct WorkspaceOptions {
+  // Folder of masks named "<image name>.png" (COLMAP's convention); empty:
+  // use <workspace>/masks if it exists, else no masks.
+  std::string mask_path;
+  // Folder of the images; empty: <workspace>/images.
+  std::string image_path;
+
+  bool Check() const;
+};
+
+struct Workspace {
+  std::string root;        // the workspace folder (dense; after undistortion the new folder)
+  std::string image_dir;   // folder of the images
+  std::string sparse_dir;  // folder holding cameras/images/points3D
+  std::string mask_dir;    // folder of masks, or "" if none
+  std::string undistortion;  // "" if already undistorted, else how it was done
+  Reconstruction model;    // all cameras are PINHOLE or SIMPLE_PINHOLE
+  std::vector<uint32_t> image_ids;  // registered images, sorted by name
+
+  std::string ImagePath(uint32_t image_id) const;
+  // Path of the mask of an image, or "" if there is none.
+  std::string MaskPath(uint32_t image_id) const;
+  // meshed-poisson.ply if present, else meshed-delaunay.ply, else "".
+  std::string DefaultMeshPath() const;
+  // Reads an image (8-bit; grayscale or BGR). Throws InputError if missing or
+  // if its size differs from its camera's.
+  cv::Mat ReadImage(uint32_t image_id, bool grayscale) const;
+  // Reads a mask (8-bit, nonzero = foreground), or an empty Mat if none.
+  cv::Mat ReadMask(uint32_t image_id) const;
+};
+
+// Opens a dense or sparse workspace. Throws InputError with the path and
+// what is missing (no images/, no sparse model, images listed in the model
+// but missing from images/, ...).
+Workspace OpenWorkspace(const std::string& path, const WorkspaceOptions& options = {});
+
+}  // namespace mr

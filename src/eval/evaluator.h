@@ -1,0 +1,36 @@
+#pragma once
+
+// Mesh accuracy against a ground-truth mesh, Middlebury-style, using exact
+// point-to-triangle distances (CGAL AABB tree) on area-uniform samples.
+
+#include <string>
+
+#include <Eigen/Core>
+
+namespace mr {
+
+struct EvaluationOptions {
+  // Completeness threshold, in scene units (Middlebury: 1.25 mm).
+  double threshold = 1.25;
+  // Number of area-uniform sample points drawn on each mesh (> 0).
+  int num_samples = 200000;
+  // Seed of the sampler (results are deterministic for a given seed).
+  int seed = 1;
+  bool Check() const;
+};
+
+struct EvaluationResult {
+  double accuracy90 = 0;     // 90th percentile of recon->GT distances
+  double completeness = 0;   // % of GT samples within `threshold` of recon
+  double chamfer = 0;        // mean(recon->GT) + mean(GT->recon), i.e. sum of both means
+  double normal_deg = 0;     // mean angle between recon and closest-GT face normals (oriented)
+  double mean_accuracy = 0;  // mean recon->GT distance
+  int faces = 0;             // faces of the evaluated mesh
+  std::string ToJson() const;  // one line
+};
+
+EvaluationResult EvaluateMesh(const Eigen::MatrixXd& V, const Eigen::MatrixXi& F,
+                              const Eigen::MatrixXd& gt_V, const Eigen::MatrixXi& gt_F,
+                              const EvaluationOptions& options = {});
+
+}  // namespace mr

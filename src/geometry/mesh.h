@@ -1,0 +1,44 @@
+#pragma once
+
+// Triangle-mesh kernels over Eigen matrices, libigl style:
+// V is #V by 3 (double), F is #F by 3 (int, counter-clockwise = outward).
+
+#include <Eigen/Core>
+#include <vector>
+
+namespace mr {
+
+// #F by 3 unit face normals (zero rows for degenerate faces).
+Eigen::MatrixXd FaceNormals(const Eigen::MatrixXd& V, const Eigen::MatrixXi& F);
+// #F face areas.
+Eigen::VectorXd FaceAreas(const Eigen::MatrixXd& V, const Eigen::MatrixXi& F);
+// #V by 3 area-weighted unit vertex normals.
+Eigen::MatrixXd VertexNormals(const Eigen::MatrixXd& V, const Eigen::MatrixXi& F);
+// Mean length over the (unique) edges; 0 for a mesh without faces.
+double MeanEdgeLength(const Eigen::MatrixXd& V, const Eigen::MatrixXi& F);
+// Length of the bounding-box diagonal of V (0 if empty).
+double BoundingBoxDiagonal(const Eigen::MatrixXd& V);
+
+// Unique undirected edges and their incident faces.
+struct EdgeTopology {
+  Eigen::MatrixXi E;  // #E by 2 vertex indices, E(e,0) < E(e,1)
+  // For each edge, the incident faces (1: boundary, 2: manifold interior,
+  // >2: non-manifold).
+  std::vector<std::vector<int>> edge_faces;
+  // For each face and corner k, the index of the edge opposite corner k
+  // (between F(f,(k+1)%3) and F(f,(k+2)%3)).
+  Eigen::MatrixXi face_edges;  // #F by 3
+
+  int NumBoundaryEdges() const;
+  int NumNonManifoldEdges() const;
+};
+EdgeTopology ComputeEdgeTopology(const Eigen::MatrixXi& F, int num_vertices);
+
+// For each vertex, its one-ring neighbour vertices (sorted, unique).
+std::vector<std::vector<int>> VertexAdjacency(const Eigen::MatrixXi& F, int num_vertices);
+
+// Removes vertices referenced by no face; `F` is re-indexed in place. Returns
+// for each old vertex its new index or -1.
+std::vector<int> RemoveUnreferencedVertices(Eigen::MatrixXd* V, Eigen::MatrixXi* F);
+
+}  // namespace mr

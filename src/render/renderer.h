@@ -1,0 +1,76 @@
+#pragma once
+
+// Headless rasterisation of a triangle mesh through EGL + OpenGL.
+//
+// The GPU resolves visibility (which face is seen at each pixel centre); the
+// depth and barycentric coordinates of that face are then computed exactly
+// (double-precision ray/triangle intersection at the pixel centre), so the
+// buffers do not depend on the driver's depth precision.
+//
+// Context creation prefers an EGL device (an NVIDIA GPU when present) and
+// falls back to Mesa (llvmpipe) through the surfaceless or device platform.
+// The choice is logged and reported by Description().
+
+#include <cstdint>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include <Eigen/Core>
+
+#include "geometry/view.h"
+
+namespace mr {
+
+// Per-pixel outputs of one render, row-major (index row * width + col).
+// Pixel (col, row) is sampled at image point (col + 0.5, row + 0.5).
+struct RenderBuffers {
+  int width = 0;
+  int height = 0;
+  std::vector<int32_t> face_id;  // visible face, -1 where the background is seen
+  std::vector<float> depth;      // camera-frame z of the surface point, 0 where none
+  // Barycentric coordinates (u, v) of the surface point in its face: the point
+  // is (1 - u - v) * V(F(f,0)) + u * V(F(f,1)) + v * V(F(f,2)). 2 per pixel.
+  std::vector<float> bary;
+
+  int FaceAt(int row, int col) const { return face_id[static_cast<size_t>(row) * width + col]; }
+  float DepthAt(int row, int col) const { return depth[static_cast<size_t>(row) * width + col]; }
+};
+
+struct RendererOptions {
+  // "auto": an EGL device first, then Mesa surfaceless; "device": EGL devices
+  // only; "surfaceless": Mesa's surfaceless platform only.
+  std::string platform = "auto";
+  bool Check() const;
+};
+
+class Renderer {
+ public:
+  // Creates the EGL context; throws mr::InputError (with what was tried) if
+  // none can be created.
+  explicit Renderer(const RendererOptions& options = {});
+  ~Renderer();
+  Renderer(const Renderer&) = delete;
+  Renderer& operator=(const Renderer&) = delete;
+
+  // "EGL device 0: NVIDIA ...", "Mesa llvmpipe (surfaceless)", ...
+  std::string Description() const;
+
+  // Uploads a mesh; it is used by all following Render calls.
+  void SetMesh(const Eigen::MatrixXd& V, const Eigen::MatrixXi& F);
+
+  // Renders the current mesh into `view` at its resolution. Faces behind the
+  // camera or closer than a small near plane are clipped.
+  RenderBuffers Render(const PinholeView& view);
+
+ private:
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+};
+
+// CPU reference implementation with the same output (slow; for tests and
+// for machines with no EGL at all).
+RenderBuffers RenderCpu(const Eigen::MatrixXd& V, const Eigen::MatrixXi& F,
+                        const PinholeView& view);
+
+}  // namespace mr

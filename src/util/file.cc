@@ -1,0 +1,97 @@
+#include "util/file.h"
+
+#include <unistd.h>
+
+#include <algorithm>
+#include <cctype>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+
+#include "util/error.h"
+
+namespace mr {
+namespace fs = std::filesystem;
+
+bool ExistsFile(const std::string& path) {
+  std::error_code ec;
+  return fs::is_regular_file(path, ec);
+}
+
+bool ExistsDir(const std::string& path) {
+  std::error_code ec;
+  return fs::is_directory(path, ec);
+}
+
+std::string JoinPaths(const std::string& a, const std::string& b) {
+  if (a.empty()) return b;
+  if (b.empty()) return a;
+  return (fs::path(a) / fs::path(b)).string();
+}
+
+std::string GetParentDir(const std::string& path) {
+  return fs::path(path).parent_path().string();
+}
+
+std::string GetFileName(const std::string& path) { return fs::path(path).filename().string(); }
+
+std::string GetExtension(const std::string& path) {
+  std::string ext = fs::path(path).extension().string();
+  std::transform(ext.begin(), ext.end(), ext.begin(),
+                 [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
+  return ext;
+}
+
+void CreateDirIfNotExists(const std::string& path) {
+  std::error_code ec;
+  if (fs::is_directory(path, ec)) return;
+  fs::create_directories(path, ec);
+  if (ec) MR_THROW_INPUT << path << ": cannot create directory: " << ec.message();
+}
+
+std::vector<std::string> ListFiles(const std::string& dir) {
+  std::vector<std::string> names;
+  std::error_code ec;
+  for (const auto& entry : fs::directory_iterator(dir, ec)) {
+    if (entry.is_regular_file()) names.push_back(entry.path().filename().string());
+  }
+  if (ec) MR_THROW_INPUT << dir << ": cannot list directory: " << ec.message();
+  std::sort(names.begin(), names.end());
+  return names;
+}
+
+std::string ReadFileToString(const std::string& path) {
+  std::ifstream file(path, std::ios::binary);
+  if (!file) MR_THROW_INPUT << path << ": cannot open file for reading";
+  std::ostringstream buffer;
+  buffer << file.rdbuf();
+  return buffer.str();
+}
+
+void WriteFileAtomically(const std::string& path,
+                         const std::function<void(std::ostream&)>& write) {
+  const fs::path target(path);
+  const fs::path dir = target.parent_path().empty() ? fs::path(".") : target.parent_path();
+  if (!fs::is_directory(dir)) {
+    MR_THROW_INPUT << path << ": output folder " << dir.string() << " does not exist";
+  }
+  const std::string tmp = path + ".tmp." + std::to_string(::getpid());
+  try {
+    {
+      std::ofstream out(tmp, std::ios::binary | std::ios::trunc);
+      if (!out) MR_THROW_INPUT << tmp << ": cannot open for writing";
+      write(out);
+      out.flush();
+      if (!out) MR_THROW_INPUT << tmp << ": write failed (disk full?)";
+    }
+    std::error_code ec;
+    fs::rename(tmp, target, ec);
+    if (ec) MR_THROW_INPUT << path << ": cannot rename temporary file into place: " << ec.message();
+  } catch (...) {
+    std::error_code ignored;
+    fs::remove(tmp, ignored);
+    throw;
+  }
+}
+
+}  // namespace mr

@@ -1,0 +1,33 @@
+#pragma once
+
+// File-system helpers with clear errors (COLMAP util/file.h style).
+
+#include <functional>
+#include <string>
+#include <vector>
+
+namespace mr {
+
+bool ExistsFile(const std::string& path);
+bool ExistsDir(const std::string& path);
+// Joins path parts with '/'.
+std::string JoinPaths(const std::string& a, const std::string& b);
+std::string GetParentDir(const std::string& path);
+std::string GetFileName(const std::string& path);
+// Lower-cased extension including the dot (".ply"), or "" if none.
+std::string GetExtension(const std::string& path);
+// Creates the directory (and parents) if missing; throws InputError on failure.
+void CreateDirIfNotExists(const std::string& path);
+// Sorted names (not paths) of regular files directly inside `dir`.
+std::vector<std::string> ListFiles(const std::string& dir);
+// Reads a whole file; throws InputError naming the path if it cannot.
+std::string ReadFileToString(const std::string& path);
+
+// Writes a file atomically: `write` fills a temporary file in the same folder
+// (opened in binary mode as `path + ".tmp.<pid>"`), which is renamed onto
+// `path` only if `write` returns without throwing and the stream is good. On
+// any failure the temporary is removed and an existing `path` is untouched.
+void WriteFileAtomically(const std::string& path,
+                         const std::function<void(std::ostream&)>& write);
+
+}  // namespace mr

@@ -1,0 +1,106 @@
+#include <gtest/gtest.h>
+
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+
+#include "util/error.h"
+#include "util/file.h"
+#include "util/options.h"
+
+namespace mr {
+namespace {
+
+std::string TempDir(const std::string& name) {
+  const auto dir = std::filesystem::temp_directory_path() / ("mr_util_test_" + name);
+  std::filesystem::remove_all(dir);
+  std::filesystem::create_directories(dir);
+  return dir.string();
+}
+
+TEST(WriteFileAtomically, Nominal) {
+  const std::string path = JoinPaths(TempDir("atomic"), "a.txt");
+  WriteFileAtomically(path, [](std::ostream& out) { out << "hello"; });
+  EXPECT_EQ(ReadFileToString(path), "hello");
+}
+
+TEST(WriteFileAtomically, FailureLeavesExistingFileUntouched) {
+  const std::string dir = TempDir("atomic_fail");
+  const std::string path = JoinPaths(dir, "a.txt");
+  WriteFileAtomically(path, [](std::ostream& out) { out << "old"; });
+  EXPECT_THROW(WriteFileAtomically(path,
+                                   [](std::ostream& out) {
+                                     out << "partial";
+                                     MR_THROW_INPUT << "simulated failure";
+                                   }),
+               InputError);
+  EXPECT_EQ(ReadFileToString(path), "old");
+  EXPECT_EQ(ListFiles(dir).size(), 1u);  // no temporary left behind
+}
+
+TEST(WriteFileAtomically, MissingFolder) {
+  EXPECT_THROW(WriteFileAtomically("/nonexistent_dir_xyz/a.txt", [](std::ostream&) {}),
+               InputError);
+}
+
+TEST(OptionManager, FlagsConfigAndOverride) {
+  const std::string dir = TempDir("options");
+  int iterations = 3;
+  double step = 0.5;
+  bool dry_run = false;
+  std::string path;
+  OptionManager options("prog", "test");
+  options.AddRequired("workspace_path", &path, "ws");
+  options.Add("Refine.num_iterations", &iterations, "it");
+  options.Add("Refine.step", &step, "step");
+  options.Add("dry_run", &dry_run, "dry");
+  const std::string ini = JoinPaths(dir, "a.ini");
+  {
+    std::ofstream f(ini);
+    f << "workspace_path=/ws\n[Refine]\nnum_iterations = 7\nstep=0.25\n";
+  }
+  const char* argv[] = {"prog", "--config_path", ini.c_str(), "--Refine.step", "0.125",
+                        "--dry_run"};
+  ASSERT_TRUE(options.Parse(6, const_cast<char**>(argv)));
+  EXPECT_EQ(path, "/ws");
+  EXPECT_EQ(iterations, 7);
+  EXPECT_DOUBLE_EQ(step, 0.125);
+  EXPECT_TRUE(dry_run);
+
+  // Round trip through --write_config.
+  const std::string out = JoinPaths(dir, "b.ini");
+  const char* argv2[] = {"prog", "--write_config", out.c_str()};
+  EXPECT_FALSE(options.Parse(3, const_cast<char**>(argv2)));
+  int iterations2 = 0;
+  double step2 = 0;
+  bool dry2 = false;
+  std::string path2;
+  OptionManager options2("prog", "test");
+  options2.AddRequired("workspace_path", &path2, "ws");
+  options2.Add("Refine.num_iterations", &iterations2, "it");
+  options2.Add("Refine.step", &step2, "step");
+  options2.Add("dry_run", &dry2, "dry");
+  options2.ReadConfig(out);
+  EXPECT_EQ(iterations2, 7);
+  EXPECT_DOUBLE_EQ(step2, 0.125);
+  EXPECT_EQ(path2, "/ws");
+}
+
+TEST(OptionManager, BadInput) {
+  int n = 0;
+  std::string s;
+  OptionManager options("prog", "test");
+  options.Add("n", &n, "n");
+  options.AddRequired("s", &s, "s");
+  const char* unknown[] = {"prog", "--s", "x", "--bogus", "1"};
+  EXPECT_THROW(options.Parse(5, const_cast<char**>(unknown)), InputError);
+  const char* not_int[] = {"prog", "--s", "x", "--n", "1.5"};
+  EXPECT_THROW(options.Parse(5, const_cast<char**>(not_int)), InputError);
+  OptionManager options2("prog", "test");
+  options2.AddRequired("s", &s, "s");
+  const char* missing[] = {"prog"};
+  EXPECT_THROW(options2.Parse(1, const_cast<char**>(missing)), InputError);
+}
+
+}  // namespace
+}  // namespace mr
