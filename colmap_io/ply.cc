@@ -12,6 +12,7 @@
 
 #include "util/error.h"
 #include "util/file.h"
+#include "util/logging.h"
 
 namespace mr {
 namespace {
@@ -556,6 +557,9 @@ TriangleMesh ReadPly(const std::string& path) {
     }
   }
 
+  if (reader.HasTrailingData()) {
+    MR_LOG(WARNING) << path << ": ignoring data after the last PLY element";
+  }
   mesh.F.resize(static_cast<Eigen::Index>(triangles.size() / 3), 3);
   for (Eigen::Index f = 0; f < mesh.F.rows(); ++f) {
     mesh.F(f, 0) = triangles[3 * f];

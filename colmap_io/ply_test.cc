@@ -225,6 +225,17 @@ TEST(Ply, BigEndianHandWritten) {
   EXPECT_EQ(mesh.F.row(0), Eigen::RowVector3i(2, 0, 1));
 }
 
+// Data after the last element is ignored (with a warning), in both modes.
+TEST(Ply, TrailingDataIsIgnored) {
+  const TriangleMesh mesh = MakeMesh(false, true, false);
+  for (PlyFormat format : {PlyFormat::kBinaryLittleEndian, PlyFormat::kAscii}) {
+    const std::string path = TempPath("trailing.ply");
+    WritePly(path, mesh, format);
+    WriteRaw(path, ReadRaw(path) + "garbage\n");
+    ExpectSameMesh(mesh, ReadPly(path));
+  }
+}
+
 TEST(Ply, FloatColorsAreScaled) {
   const std::string path = TempPath("float_colors.ply");
   WriteRaw(path,
