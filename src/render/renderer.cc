@@ -164,7 +164,7 @@ Renderer::Renderer(const RendererOptions& options) : impl_(new Impl) {
                    << " is older than the 3.3 core profile the renderer needs";
   }
   m.clip_control = major * 10 + minor >= 45;
-  if (!m.clip_control) {
+  if (!m.clip_control && options.reverse_z) {
     GLint num_ext = 0;
     glGetIntegerv(GL_NUM_EXTENSIONS, &num_ext);
     for (GLint i = 0; i < num_ext; ++i) {
@@ -174,6 +174,7 @@ Renderer::Renderer(const RendererOptions& options) : impl_(new Impl) {
       }
     }
   }
+  if (!options.reverse_z) m.clip_control = false;
   GLint max_rb = 0, max_vp[2] = {0, 0};
   glGetIntegerv(GL_MAX_RENDERBUFFER_SIZE, &max_rb);
   glGetIntegerv(GL_MAX_VIEWPORT_DIMS, max_vp);
@@ -186,7 +187,7 @@ Renderer::Renderer(const RendererOptions& options) : impl_(new Impl) {
   std::ostringstream desc;
   desc << GlString(GL_VENDOR) << " " << GlString(GL_RENDERER) << ", OpenGL " << version << " via "
        << m.egl->path();
-  if (!m.clip_control) desc << " (no clip control: standard depth)";
+  if (!m.clip_control) desc << " (standard depth, no reverse-Z)";
   m.description = desc.str();
   MR_LOG(INFO) << "Renderer: " << m.description;
 
@@ -239,10 +240,10 @@ int Renderer::SubpixelBits() const { return impl_->subpixel_bits; }
 
 void Renderer::SetMesh(const Eigen::MatrixXd& V, const Eigen::MatrixXi& F) {
   Impl& m = *impl_;
+  m.MakeCurrent();  // also checks the calling thread
   PinholeView dummy;
   dummy.width = dummy.height = 1;
   internal::CheckViewAndMesh(V, F, dummy);
-  m.MakeCurrent();
   m.V = V;
   m.F = F;
   m.centroid = V.rows() > 0 ? Eigen::Vector3d(V.colwise().mean().transpose())
@@ -273,13 +274,14 @@ void Renderer::SetMesh(const Eigen::MatrixXd& V, const Eigen::MatrixXi& F) {
 
 RenderBuffers Renderer::Render(const PinholeView& view) {
   Impl& m = *impl_;
+  m.MakeCurrent();  // also checks the calling thread
   internal::CheckViewAndMesh(m.V, m.F, view);
   const int W = view.width, H = view.height;
   RenderBuffers out = internal::EmptyBuffers(W, H);
   double far = 0;
   const double near = internal::NearPlane(m.V, view, &far);
   if (m.F.rows() == 0 || !(near > 0)) return out;
-  m.MakeCurrent();
+  const double start_s = ElapsedSeconds();
 
   // 1. Visibility on the GPU, tile by tile (a tile is the view with the
   //    principal point shifted by the tile's origin).
@@ -302,6 +304,7 @@ RenderBuffers Renderer::Render(const PinholeView& view) {
   glPixelStorei(GL_PACK_ALIGNMENT, 4);
   std::vector<int32_t> tile_ids(static_cast<size_t>(tile_w) * tile_h);
   std::vector<int32_t> ids(static_cast<size_t>(W) * H);
+  double draw_s = 0;  // clear + draw (measured only when logging verbosely)
   for (int y0 = 0; y0 < H; y0 += tile_h) {
     for (int x0 = 0; x0 < W; x0 += tile_w) {
       const int tw = std::min(tile_w, W - x0), th = std::min(tile_h, H - y0);
@@ -310,6 +313,7 @@ RenderBuffers Renderer::Render(const PinholeView& view) {
       tile.height = th;
       tile.cx -= x0;
       tile.cy -= y0;
+      const double tile_s = ElapsedSeconds();
       glViewport(0, 0, tw, th);
       const GLint zero[4] = {0, 0, 0, 0};
       glClearBufferiv(GL_COLOR, 0, zero);
@@ -318,6 +322,10 @@ RenderBuffers Renderer::Render(const PinholeView& view) {
       const Eigen::Matrix4f M = m.ClipFromLocal(tile, near, far);
       glUniformMatrix4fv(m.clip_from_local_loc, 1, GL_FALSE, M.data());  // column-major
       glDrawElements(GL_TRIANGLES, static_cast<GLsizei>(m.F.rows() * 3), GL_UNSIGNED_INT, nullptr);
+      if (LogEnabled(LogLevel::kVerbose)) {
+        glFinish();
+        draw_s += ElapsedSeconds() - tile_s;
+      }
       glReadPixels(0, 0, tw, th, GL_RED_INTEGER, GL_INT, tile_ids.data());
       m.CheckGl("render");
       for (int r = 0; r < th; ++r) {
@@ -328,6 +336,7 @@ RenderBuffers Renderer::Render(const PinholeView& view) {
   }
   glBindVertexArray(0);
   glBindFramebuffer(GL_FRAMEBUFFER, 0);
+  const double gpu_s = ElapsedSeconds();
 
   // 2. Exact depth and barycentrics on the CPU: intersect the pixel-centre ray
   //    with the visible face in double precision. Where the ray misses the
@@ -340,7 +349,7 @@ RenderBuffers Renderer::Render(const PinholeView& view) {
   const Eigen::MatrixXd& V = m.V;
   const Eigen::MatrixXi& F = m.F;
   bool bad_id = false;
-#pragma omp parallel for schedule(static)
+#pragma omp parallel for schedule(static) reduction(|| : bad_id)
   for (int row = 0; row < H; ++row) {
     const double dy = (row + 0.5 - view.cy) / view.fy;
     for (int col = 0; col < W; ++col) {
@@ -376,6 +385,10 @@ RenderBuffers Renderer::Render(const PinholeView& view) {
     }
   }
   MR_CHECK(!bad_id) << "GPU returned a face id beyond the mesh's " << num_faces << " faces";
+  MR_LOG(VERBOSE) << "Render " << W << "x" << H << ": visibility (GL) "
+                  << 1e3 * (gpu_s - start_s) << " ms (draw " << 1e3 * draw_s
+                  << " ms), exact depth (CPU) "
+                  << 1e3 * (ElapsedSeconds() - gpu_s) << " ms";
   return out;
 }
 

@@ -62,6 +62,10 @@ struct RendererOptions {
   // Largest side of the offscreen framebuffer (pixels, >= 0; 0 = the driver's
   // limit, at most 4096). Larger views are rendered in tiles.
   int max_tile_size = 0;
+  // Reverse-Z depth (depth = near / z, float precision uniform in z) when the
+  // context has GL 4.5 or ARB_clip_control; false forces the classic
+  // [-1, 1] perspective depth (near/far from the mesh bounds).
+  bool reverse_z = true;
   bool Check() const;
 };
 

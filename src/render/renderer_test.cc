@@ -6,6 +6,7 @@
 #include <cstdlib>
 #include <memory>
 #include <string>
+#include <thread>
 
 #include <Eigen/Geometry>
 
@@ -118,19 +119,21 @@ void ExpectAnalyticTriangle(const RenderBuffers& buf, const PinholeView& view,
   EXPECT_GT(judged, view.width * view.height * 9 / 10) << what;
 }
 
+// `renderer` may be null: then only the CPU reference is checked.
 void CheckAnalyticTriangle(Renderer* renderer, const PinholeView& view, const Eigen::Vector2d p[3],
                            double z) {
   Eigen::MatrixXd V(3, 3);
   for (int k = 0; k < 3; ++k) V.row(k) = Unproject(view, p[k].x(), p[k].y(), z).transpose();
   Eigen::MatrixXi F(1, 3);
   F << 0, 1, 2;
+  ExpectAnalyticTriangle(RenderCpu(V, F, view), view, p, z, 1e-3, "CPU");
+  if (renderer == nullptr) return;
   renderer->SetMesh(V, F);
   // The GPU snaps vertices to 1/2^SubpixelBits() px (1/256 on llvmpipe and
   // NVIDIA), which moves edges by up to ~0.7 of that: pixels that close to an
   // edge may go either way. The CPU reference is exact (1e-3 px).
   const double gpu_tol = std::ldexp(1.0, -std::max(renderer->SubpixelBits(), 4));
   ExpectAnalyticTriangle(renderer->Render(view), view, p, z, gpu_tol, "GPU");
-  ExpectAnalyticTriangle(RenderCpu(V, F, view), view, p, z, 1e-3, "CPU");
 }
 
 TEST(RendererOptions, DefaultsAreValid) { EXPECT_TRUE(RendererOptions().Check()); }
@@ -142,6 +145,25 @@ TEST(RendererOptions, BadValuesThrow) {
   o = RendererOptions();
   o.max_tile_size = -1;
   EXPECT_THROW(o.Check(), InputError);
+}
+
+// The CPU reference alone (runs without EGL too).
+TEST(RenderCpu, SingleTriangleMatchesAnalytic) {
+  const Eigen::Vector2d p[3] = {{20.3, 15.2}, {130.7, 30.1}, {60.2, 100.9}};
+  CheckAnalyticTriangle(nullptr, MakeView(160, 120, 100, 100, 80, 60), p, 5.0);
+  const Eigen::Vector2d q[3] = {{5.5, 3.3}, {40.6, 115.2}, {150.1, 60.4}};
+  CheckAnalyticTriangle(nullptr, MakeView(160, 120, 90, 110, 31.5, 92.25), q, 3.0);
+}
+
+TEST(RenderCpu, EmptyAndBadInput) {
+  const PinholeView view = MakeView(64, 48, 50, 50, 32, 24);
+  const RenderBuffers buf = RenderCpu(Eigen::MatrixXd(0, 3), Eigen::MatrixXi(0, 3), view);
+  ASSERT_EQ(buf.face_id.size(), 64u * 48u);
+  for (int id : buf.face_id) EXPECT_EQ(id, -1);
+  Eigen::MatrixXd V = Eigen::MatrixXd::Random(3, 3);
+  Eigen::MatrixXi F(1, 3);
+  F << 0, 1, 3;
+  EXPECT_THROW(RenderCpu(V, F, view), InputError);
 }
 
 TEST(Renderer, DescriptionNamesThePath) {
@@ -243,6 +265,27 @@ TEST(Renderer, IcosphereMatchesCpu) {
   EXPECT_GT(agree / n, 0.995);
   EXPECT_GT(hit / n, 0.2);
   EXPECT_GT(both, hit * 99 / 100);
+}
+
+// The classic [-1, 1] depth path (used where GL 4.5 / ARB_clip_control is
+// missing) resolves occlusion like reverse-Z.
+TEST(Renderer, StandardDepthMatchesCpu) {
+  GET_RENDERER(r);
+  RendererOptions options;
+  options.reverse_z = false;
+  Renderer classic(options);
+  EXPECT_NE(classic.Description().find("standard depth"), std::string::npos);
+  Eigen::MatrixXd V;
+  Eigen::MatrixXi F;
+  MakeIcosphere(3, 1.0, Eigen::Vector3d::Zero(), &V, &F);
+  PinholeView view = MakeView(120, 90, 100, 100, 60, 45);
+  view.t = Eigen::Vector3d(0.1, 0, 3);
+  classic.SetMesh(V, F);
+  const RenderBuffers gpu = classic.Render(view);
+  const RenderBuffers cpu = RenderCpu(V, F, view);
+  int agree = 0;
+  for (size_t i = 0; i < gpu.face_id.size(); ++i) agree += gpu.face_id[i] == cpu.face_id[i];
+  EXPECT_GT(agree, static_cast<int>(gpu.face_id.size() * 995 / 1000));
 }
 
 TEST(Renderer, TiledRenderMatchesUntiled) {
@@ -378,6 +421,22 @@ TEST(Renderer, BadMeshThrows) {
   EXPECT_THROW(r->SetMesh(V, F), InputError);
   const PinholeView bad = MakeView(0, 48, 50, 50, 32, 24);
   EXPECT_THROW(RenderCpu(V, F, bad), InputError);
+}
+
+// The EGL context belongs to the creating thread: use from another thread is
+// refused with an error, not undefined behaviour.
+TEST(Renderer, OtherThreadIsRefused) {
+  GET_RENDERER(r);
+  bool threw = false;
+  std::thread other([&] {
+    try {
+      r->Render(MakeView(8, 8, 10, 10, 4, 4));
+    } catch (const InternalError&) {
+      threw = true;
+    }
+  });
+  other.join();
+  EXPECT_TRUE(threw);
 }
 
 // A triangle in the upper left of the image (small x and y) must appear in
