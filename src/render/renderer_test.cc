@@ -267,6 +267,32 @@ TEST(Renderer, IcosphereMatchesCpu) {
   EXPECT_GT(both, hit * 99 / 100);
 }
 
+// Geo-referenced coordinates (1e6 m offsets, a 1 m sphere): float positions
+// are only accurate because the centroid is subtracted before upload.
+TEST(Renderer, LargeCoordinatesMatchCpu) {
+  GET_RENDERER(r);
+  const Eigen::Vector3d offset(3.2e6, -1.7e6, 2.5e5);
+  Eigen::MatrixXd V;
+  Eigen::MatrixXi F;
+  MakeIcosphere(3, 1.0, offset, &V, &F);
+  PinholeView view = MakeView(120, 90, 110, 110, 61, 44);
+  view.R = Eigen::AngleAxisd(-0.7, Eigen::Vector3d(0.2, 1, 0.1).normalized()).toRotationMatrix();
+  view.t = Eigen::Vector3d(0, 0, 3) - view.R * offset;
+  r->SetMesh(V, F);
+  const RenderBuffers gpu = r->Render(view);
+  const RenderBuffers cpu = RenderCpu(V, F, view);
+  int agree = 0, hit = 0;
+  for (size_t i = 0; i < gpu.face_id.size(); ++i) {
+    agree += gpu.face_id[i] == cpu.face_id[i];
+    hit += cpu.face_id[i] >= 0;
+    if (gpu.face_id[i] >= 0 && cpu.face_id[i] >= 0) {
+      EXPECT_NEAR(gpu.depth[i], cpu.depth[i], 1e-4 * cpu.depth[i]);
+    }
+  }
+  EXPECT_GT(hit, static_cast<int>(gpu.face_id.size() / 5));
+  EXPECT_GT(agree, static_cast<int>(gpu.face_id.size() * 995 / 1000));
+}
+
 // The classic [-1, 1] depth path (used where GL 4.5 / ARB_clip_control is
 // missing) resolves occlusion like reverse-Z.
 TEST(Renderer, StandardDepthMatchesCpu) {
