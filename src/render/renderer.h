@@ -22,8 +22,13 @@
 // 32-bit float depth when GL 4.5 / ARB_clip_control is available); depth
 // and barycentrics come from a double-precision ray/triangle intersection.
 // On silhouette pixels where the pixel-centre ray misses the rasterised face
-// numerically, the barycentrics are clamped to the triangle and the depth is
+// numerically (the GPU snaps vertices to 1/2^SubpixelBits() px, so it may
+// disagree with the exact test within ~2^-SubpixelBits() px of an edge), the
+// barycentrics are clamped to the triangle and the depth is
 // that of the clamped point.
+//
+// Memory: SetMesh keeps a copy of (V, F) for the exact CPU step, besides the
+// GPU buffers (12 bytes per vertex, 12 per face).
 //
 // Near plane: 0.9 x the smallest camera z of the mesh's bounding box when it
 // is in front of the camera; otherwise 1e-5 x the scene depth (see
