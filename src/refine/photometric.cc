@@ -4,6 +4,10 @@
 #include <cmath>
 
 #include "refine/pyramid.h"
+
+#ifdef _OPENMP
+#include <omp.h>
+#endif
 #include "util/error.h"
 
 namespace mr {
@@ -26,12 +30,14 @@ bool WarpPixel(const MeshGeometry& mesh, const PinholeView& view_i, const Render
   const size_t idx = static_cast<size_t>(row) * render_i.width + col;
   const int f = render_i.face_id[idx];
   if (f < 0) return false;
-  const double d = render_i.depth[idx];
-  if (!(d > 0)) return false;
   const Eigen::Vector3d n = mesh.face_normals.row(f);
   const Eigen::Vector3d ray = view_i.RayDirection(col + 0.5, row + 0.5);
-  const Eigen::Vector3d x = view_i.Center() + d * ray;
   if (std::abs(n.dot(ray.normalized())) < options.min_cos_angle) return false;
+  // Exact depth of the ray's hit on the face's plane.
+  const Eigen::Vector3d a = mesh.V->row((*mesh.F)(f, 0));
+  const double d = n.dot(a - view_i.Center()) / n.dot(ray);
+  if (!(d > 0)) return false;
+  const Eigen::Vector3d x = view_i.Center() + d * ray;
 
   const Eigen::Vector3d xj = view_j.WorldToCamera(x);
   if (xj.z() <= 0) return false;
@@ -88,7 +94,9 @@ void DataTerm::Reset(int num_vertices) {
   curvature = Eigen::VectorXd::Zero(num_vertices);
   weight = Eigen::VectorXd::Zero(num_vertices);
   footprint = Eigen::VectorXd::Zero(num_vertices);
-  energy = 0;
+  cost = 0;
+  zncc_sum = 0;
+  weight_sum = 0;
   valid_pixels = 0;
 }
 
@@ -97,7 +105,9 @@ void DataTerm::Add(const DataTerm& other) {
   curvature += other.curvature;
   weight += other.weight;
   footprint += other.footprint;
-  energy += other.energy;
+  cost += other.cost;
+  zncc_sum += other.zncc_sum;
+  weight_sum += other.weight_sum;
   valid_pixels += other.valid_pixels;
 }
 
@@ -108,15 +118,14 @@ void PredictImage(const MeshGeometry& mesh, const PinholeView& view_i,
   MR_CHECK(image_j.type() == CV_32F) << "image_j must be CV_32F";
   MR_CHECK(render_i.width == view_i.width && render_i.height == view_i.height);
   MR_CHECK(render_j.width == view_j.width && render_j.height == view_j.height);
-  *predicted = cv::Mat::zeros(view_i.height, view_i.width, CV_32F);
+  *predicted = cv::Mat::zeros(view_i.height, view_i.width, CV_64F);
   *mask = cv::Mat::zeros(view_i.height, view_i.width, CV_8U);
 #pragma omp parallel for schedule(dynamic, 8)
   for (int row = 0; row < view_i.height; ++row) {
     PixelWarp warp;
     for (int col = 0; col < view_i.width; ++col) {
       if (!WarpPixel(mesh, view_i, render_i, view_j, render_j, options, row, col, &warp)) continue;
-      predicted->at<float>(row, col) =
-          static_cast<float>(SampleBilinear(image_j, warp.q.x(), warp.q.y(), nullptr));
+      predicted->at<double>(row, col) = SampleBilinear(image_j, warp.q.x(), warp.q.y(), nullptr);
       mask->at<uint8_t>(row, col) = 255;
     }
   }
@@ -133,9 +142,19 @@ long AccumulatePairTerm(const MeshGeometry& mesh, const PinholeView& view_i,
   const long valid = cv::countNonZero(mask);
   if (valid == 0) return 0;
 
-  const SimilarityMaps maps = ComputeSimilarity(image_i, predicted, mask, similarity);
-  term->energy += maps.energy;
+  // Both images in the precision the similarity computes in.
+  cv::Mat observed = image_i;
+  if (similarity.double_precision) {
+    image_i.convertTo(observed, CV_64F);
+  } else {
+    predicted.convertTo(predicted, CV_32F);
+  }
+  const SimilarityResult maps = ComputeSimilarity(observed, predicted, mask, similarity);
+  term->cost += maps.cost;
+  term->zncc_sum += maps.zncc_sum;
+  term->weight_sum += maps.weight_sum;
   term->valid_pixels += valid;
+  const bool dp = maps.gradient.depth() == CV_64F;
 
   const Eigen::MatrixXi& F = *mesh.F;
   const int height = view_i.height, width = view_i.width;
@@ -168,8 +187,9 @@ long AccumulatePairTerm(const MeshGeometry& mesh, const PinholeView& view_i,
       const double n_dot_r = n.dot(warp.ray);
       // a = ∇I_jᵀ Jπ_j r / (n·r): intensity change per unit normal motion.
       const double a = grad_j.dot(warp.jacobian_j * warp.ray) / n_dot_r;
-      const double g = maps.gradient.at<double>(row, col);
-      const double v2 = maps.var2.at<double>(row, col);
+      const double g = dp ? maps.gradient.at<double>(row, col) : maps.gradient.at<float>(row, col);
+      const double v2 = dp ? maps.variance_predicted.at<double>(row, col)
+                           : maps.variance_predicted.at<float>(row, col);
       const double footprint = warp.depth / view_i.fx;
       const double u = render_i.bary[2 * idx], v = render_i.bary[2 * idx + 1];
       const double w[3] = {1.0 - u - v, u, v};

@@ -12,15 +12,19 @@
 //   dx = r_p (n · w_k δ) / (n · r_p),
 // and the predicted intensity Î(p) = I_j(π_j(x)) changes by
 //   dÎ(p) = ∇I_j(π_j x)ᵀ Jπ_j(x) r_p (n · w_k δ) / (n · r_p).
-// With g(p) = ∂E/∂Î(p) from the similarity measure, the vertex gradient is
-//   ∂E/∂X_k = Σ_p w_k(p) g(p) a(p) n(p),  a = ∇I_jᵀ Jπ_j r_p / (n · r_p).
+// With g(p) = ∂C/∂Î(p) from the similarity measure (C = Σ_p (1 - m(p)), the
+// reprojection error), the vertex gradient is
+//   ∂C/∂X_k = Σ_p w_k(p) g(p) a(p) n(p),  a = ∇I_jᵀ Jπ_j r_p / (n · r_p).
 // Pixels whose x is hidden in view j, falls outside image j, or is seen at a
 // grazing angle are outside the valid domain π_i∘S_ij and contribute nothing.
 //
+// The depth d is recomputed in double precision from the face's plane, so the
+// term is exact given the visible face of each pixel.
+//
 // Alongside the gradient a Gauss-Newton curvature H_k = Σ_p w_k a² / v₂(p)
 // is accumulated (v₂ the local variance of Î; 1/v₂ is the curvature of
-// -ZNCC with respect to one predicted pixel near a match). The refiner steps
-// by G_k / H_k, which is invariant to the scale of the scene.
+// 1 - ZNCC with respect to one predicted pixel near a match). The refiner
+// steps by -G_k / H_k, which is invariant to the scale of the scene.
 
 #include <opencv2/core.hpp>
 
@@ -45,16 +49,19 @@ struct PairTermOptions {
 
 // Per-vertex sums over pixels and pairs.
 struct DataTerm {
-  Eigen::MatrixXd gradient;   // #V by 3: ∂E/∂X (E = similarity, to be increased)
+  Eigen::MatrixXd gradient;   // #V by 3: ∂C/∂X (C = reprojection error, to be decreased)
   Eigen::VectorXd curvature;  // #V: Gauss-Newton curvature along the normal
   Eigen::VectorXd weight;     // #V: Σ_p w_k (pixel coverage)
   Eigen::VectorXd footprint;  // #V: Σ_p w_k * (pixel footprint in world units)
-  double energy = 0;          // Σ over valid pixels of the local similarity m(p)
+  double cost = 0;            // C = Σ_p W(p) (1 - m(p)) over all pairs
+  double zncc_sum = 0;        // Σ_p W(p) m(p)
+  double weight_sum = 0;      // Σ_p W(p)
   long valid_pixels = 0;
 
   void Reset(int num_vertices);
   void Add(const DataTerm& other);
-  double MeanSimilarity() const { return valid_pixels > 0 ? energy / valid_pixels : 0.0; }
+  // Mean local ZNCC over the valid pixels of all pairs, in [-1, 1].
+  double MeanSimilarity() const { return weight_sum > 0 ? zncc_sum / weight_sum : 0.0; }
 };
 
 // The mesh as the pair term needs it.
@@ -64,7 +71,7 @@ struct MeshGeometry {
   Eigen::MatrixXd face_normals;        // #F by 3 unit normals
 };
 
-// Builds the predicted image Î_ij in view i (CV_32F, 0 outside the valid
+// Builds the predicted image Î_ij in view i (CV_64F, 0 outside the valid
 // domain) and the valid-domain mask (CV_8U, 255 = valid). `image_j` is CV_32F.
 void PredictImage(const MeshGeometry& mesh, const PinholeView& view_i,
                   const RenderBuffers& render_i, const PinholeView& view_j,

@@ -305,14 +305,15 @@ RefineSummary RefineMesh(const ViewSource& source, const RefineOptions& options,
                           "not visible in overlapping views";
       }
 
-      // Gauss-Newton step on the data term, clamped to max_step_px footprints.
+      // Gauss-Newton step down the reprojection error, clamped to max_step_px
+      // footprints.
       const double mu = options.damping * MedianPositive(term.curvature);
       Eigen::MatrixXd step = Eigen::MatrixXd::Zero(V.rows(), 3);
       double step_sum = 0, step_max = 0;
       long num_moved = 0;
       for (int v = 0; v < V.rows(); ++v) {
         if (!(term.weight(v) > 0) || !(term.curvature(v) + mu > 0)) continue;
-        Eigen::Vector3d d = options.step * term.gradient.row(v) / (term.curvature(v) + mu);
+        Eigen::Vector3d d = -options.step * term.gradient.row(v) / (term.curvature(v) + mu);
         const double footprint = term.footprint(v) / term.weight(v);
         const double limit = options.max_step_px * footprint;
         if (d.norm() > limit) d *= limit / d.norm();
