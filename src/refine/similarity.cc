@@ -141,8 +141,11 @@ void SimilarityOneChannel(const cv::Mat& I1, const cv::Mat& I2, const cv::Mat& M
   }
   G.Apply(F, &Fs);
 
-  // Per pixel: m, the cost, and the backward maps A, A mu1, B, B mu2, K.
-  const int nb = with_kappa ? 5 : 4;
+  // Per pixel: m, the cost, and the three backward maps A, B and
+  // A mu1 - B mu2 (+ kappa K for dcv), so that alpha = -G*A, beta = G*B and
+  // gamma = G*(A mu1 - B mu2) (+ the De17 term, by linearity of G*).
+  const T kappa = static_cast<T>(options.kappa);
+  constexpr int nb = 3;
   cv::Mat R;
   if (compute_gradient) R.create(rows, cols, CV_MAKETYPE(cv::DataType<T>::depth, nb));
   double cost = 0, zsum = 0, wsum = 0;
@@ -159,26 +162,27 @@ void SimilarityOneChannel(const cv::Mat& I1, const cv::Mat& I2, const cv::Mat& M
         if (b) std::fill(b + c * nb, b + (c + 1) * nb, T(0));
         continue;
       }
-      const T mu1 = fs[1] / omega, mu2 = fs[2] / omega;
+      const T inv_omega = T(1) / omega;
+      const T mu1 = fs[1] * inv_omega, mu2 = fs[2] * inv_omega;
       // v_k >= eps in exact arithmetic (Cauchy-Schwarz); clamp rounding only.
-      const T v1 = std::max(fs[3] / omega - mu1 * mu1 + eps, eps);
-      const T v2 = std::max(fs[4] / omega - mu2 * mu2 + eps, eps);
-      const T v12 = fs[5] / omega - mu1 * mu2;
-      const T s = std::sqrt(v1 * v2);
-      const T zn = v12 / s;
+      const T v1 = std::max(fs[3] * inv_omega - mu1 * mu1 + eps, eps);
+      const T v2 = std::max(fs[4] * inv_omega - mu2 * mu2 + eps, eps);
+      const T v12 = fs[5] * inv_omega - mu1 * mu2;
+      const T inv_s = T(1) / std::sqrt(v1 * v2);
+      const T zn = v12 * inv_s;
       z[c] = zn;
       cost += static_cast<double>(W) * (1.0 - static_cast<double>(zn));
       zsum += static_cast<double>(W) * zn;
       wsum += W;
       if (b) {
-        const T A = W / (omega * s);
-        const T B = W * zn / (omega * v2);
+        const T inv_v2 = T(1) / v2;
+        const T A = W * inv_omega * inv_s;
+        const T B = W * zn * inv_omega * inv_v2;
         T* o = b + c * nb;
         o[0] = A;
-        o[1] = A * mu1;
-        o[2] = B;
-        o[3] = B * mu2;
-        if (with_kappa) o[4] = W * (v2 - v1) / v2;
+        o[1] = B;
+        o[2] = A * mu1 - B * mu2;
+        if (with_kappa) o[2] += kappa * (W * (v2 - v1) * inv_v2);
       }
     }
   }
@@ -187,11 +191,11 @@ void SimilarityOneChannel(const cv::Mat& I1, const cv::Mat& I2, const cv::Mat& M
   result->weight_sum += wsum;
   if (!compute_gradient) return;
 
-  // Backward: dC/dI2(q) = M(q) [-x(q) G*A + G*(A mu1) + y(q) G*B - G*(B mu2)]
-  // (+ kappa M(q) G*K for dcv), in centred coordinates x = I1 - c1, y = I2 - c2.
+  // Backward: dC/dI2(q) = M(q) [-x(q) G*A + y(q) G*B + G*(A mu1 - B mu2)]
+  // (+ kappa M(q) G*K for dcv, inside the last map), in centred coordinates
+  // x = I1 - c1, y = I2 - c2 (mu1, mu2 are centred the same way).
   cv::Mat Rs;
   G.Apply(R, &Rs);
-  const T kappa = static_cast<T>(options.kappa);
   for (int r = 0; r < rows; ++r) {
     const T* m = M.ptr<T>(r);
     const T* a = I1.ptr<T>(r);
@@ -200,14 +204,7 @@ void SimilarityOneChannel(const cv::Mat& I1, const cv::Mat& I2, const cv::Mat& M
     T* g = gradient->ptr<T>(r);
     for (int c = 0; c < cols; ++c, rs += nb) {
       const T w = m[c];
-      if (!(w > 0)) {
-        g[c] = 0;
-        continue;
-      }
-      const T x = a[c] - c1, y = bb[c] - c2;
-      T d = -x * rs[0] + rs[1] + y * rs[2] - rs[3];
-      if (with_kappa) d += kappa * rs[4];
-      g[c] = w * d;
+      g[c] = w > 0 ? w * (-(a[c] - c1) * rs[0] + (bb[c] - c2) * rs[1] + rs[2]) : T(0);
     }
   }
 }
