@@ -60,32 +60,35 @@ class GaussianFilter {
 // channel value of either image is not finite.
 template <typename T>
 cv::Mat EffectiveMask(const cv::Mat& I1, const cv::Mat& I2, const cv::Mat& mask) {
-  const int rows = I1.rows, cols = I1.cols, cn = I1.channels();
+  const int rows = I1.rows, cols = I1.cols, n = cols * I1.channels(), cn = I1.channels();
   cv::Mat M(rows, cols, cv::DataType<T>::type);
   for (int r = 0; r < rows; ++r) {
-    const T* a = I1.ptr<T>(r);
-    const T* b = I2.ptr<T>(r);
     T* m = M.ptr<T>(r);
-    for (int c = 0; c < cols; ++c) {
-      double w = 1;
-      if (!mask.empty()) {
-        if (mask.depth() == CV_8U) {
-          w = mask.ptr<uchar>(r)[c] != 0 ? 1 : 0;
-        } else if (mask.depth() == CV_32F) {
-          w = mask.ptr<float>(r)[c];
-        } else {
-          w = mask.ptr<double>(r)[c];
-        }
+    if (mask.empty()) {
+      std::fill(m, m + cols, T(1));
+    } else if (mask.depth() == CV_8U) {
+      const uchar* k = mask.ptr<uchar>(r);
+      for (int c = 0; c < cols; ++c) m[c] = k[c] != 0 ? T(1) : T(0);
+    } else {
+      for (int c = 0; c < cols; ++c) {
+        double w = mask.depth() == CV_32F ? mask.ptr<float>(r)[c] : mask.ptr<double>(r)[c];
         // Tolerate rounding (a blurred binary mask overshoots 1 by ~1e-16).
         MR_CHECK(w >= -1e-6 && w <= 1 + 1e-6)
             << "ComputeSimilarity: mask value " << w << " at (" << c << ", " << r
             << "), expected in [0, 1]";
-        w = std::min(std::max(w, 0.0), 1.0);
+        m[c] = static_cast<T>(std::min(std::max(w, 0.0), 1.0));
       }
-      for (int k = 0; k < cn && w > 0; ++k) {
-        if (!std::isfinite(a[c * cn + k]) || !std::isfinite(b[c * cn + k])) w = 0;
+    }
+    // Non-finite pixels are invalid. (x - x is 0 for finite x, NaN otherwise.)
+    const T* a = I1.ptr<T>(r);
+    const T* b = I2.ptr<T>(r);
+    bool all_finite = true;
+    for (int j = 0; j < n; ++j) all_finite &= (a[j] - a[j] == 0) & (b[j] - b[j] == 0);
+    if (all_finite) continue;
+    for (int c = 0; c < cols; ++c) {
+      for (int k = 0; k < cn; ++k) {
+        if (!std::isfinite(a[c * cn + k]) || !std::isfinite(b[c * cn + k])) m[c] = 0;
       }
-      m[c] = static_cast<T>(w);
     }
   }
   return M;
@@ -220,9 +223,11 @@ SimilarityResult ComputeTyped(const cv::Mat& observed, const cv::Mat& predicted,
   const cv::Mat M = EffectiveMask<T>(I1, I2, mask);
   const GaussianFilter G(options.sigma, depth);
 
-  std::vector<cv::Mat> ch1, ch2;
-  cv::split(I1, ch1);
-  cv::split(I2, ch2);
+  std::vector<cv::Mat> ch1{I1}, ch2{I2};
+  if (I1.channels() > 1) {
+    cv::split(I1, ch1);
+    cv::split(I2, ch2);
+  }
   const int cn = static_cast<int>(ch1.size());
   std::vector<cv::Mat> z(cn), g(cn);
   SimilarityResult result;

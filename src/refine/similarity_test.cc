@@ -321,6 +321,48 @@ TEST(Similarity, DcvTermSignFollowsVarianceExcess) {
   }
 }
 
+// What the added term does NOT do: in image space it is close to a local
+// brightness offset (a Gaussian-smoothed field), to which local variances are
+// blind: a step I2 -= eta K changes v2 only through the local covariance of I2
+// and K, with no definite sign. Compared with a step of the same amplitude
+// (<= 0.1) along a direction that does target the variances, P(q) =
+// (v2 - v1)(q) (I2(q) - mu2(q)), it changes the variance gap
+// sum_p |v2 - v1| by far less (see docs/similarity.md).
+TEST(Similarity, DcvTermIsNearlyABrightnessOffsetInImageSpace) {
+  const int cols = 48, rows = 40;
+  const cv::Mat I1 = RandomImage(cols, rows, 33);
+  cv::Mat mask(rows, cols, CV_8U, cv::Scalar(0));
+  cv::circle(mask, cv::Point(24, 20), 17, cv::Scalar(255), -1);
+  cv::Mat M;
+  mask.convertTo(M, CV_64F, 1.0 / 255);
+  cv::Mat noise(rows, cols, CV_64F);
+  cv::randn(noise, 0, 0.02);
+  const double sigma = 2;
+  auto gap = [&](const cv::Mat& I2) {
+    const Reference ref = BruteStatistics(I1, I2, mask, sigma, 1e-4);
+    double g = 0;
+    for (int r = 0; r < rows; ++r)
+      for (int c = 0; c < cols; ++c)
+        if (mask.at<uchar>(r, c)) g += std::abs(ref.v2.at<double>(r, c) - ref.v1.at<double>(r, c));
+    return g;
+  };
+  for (const double a : {2.0, 0.5}) {
+    const cv::Mat I2 = a * (I1 - 0.5) + 0.5 + noise;
+    const SimilarityResult z = ComputeSimilarity(I1, I2, mask, DoubleOptions("zncc", sigma, 0));
+    const SimilarityResult d = ComputeSimilarity(I1, I2, mask, DoubleOptions("dcv", sigma, 1.0));
+    const cv::Mat K = d.gradient - z.gradient;
+    const Reference ref = BruteStatistics(I1, I2, mask, sigma, 1e-4);
+    const cv::Mat P = M.mul((ref.v2 - ref.v1).mul(I2 - ref.mu2));
+    const double before = gap(I2);
+    const double after_k = gap(I2 - 0.1 / cv::norm(K, cv::NORM_INF) * K);
+    const double after_p = gap(I2 - 0.1 / cv::norm(P, cv::NORM_INF) * P);
+    std::printf("a = %.1f: variance gap %.4f -> %.4f (kappa term), %.4f (variance direction)\n", a,
+                before, after_k, after_p);
+    EXPECT_LT(after_p, before);
+    EXPECT_LT(std::abs(after_k - before), 0.1 * (before - after_p));
+  }
+}
+
 TEST(Similarity, FloatMatchesDouble) {
   const int cols = 64, rows = 48;
   const cv::Mat I1 = RandomImage(cols, rows, 17), I2 = RandomImage(cols, rows, 18);
