@@ -196,6 +196,22 @@ void CheckGradientByFiniteDifferences(const cv::Mat& I1, const cv::Mat& I2, cons
     }
 }
 
+TEST(Similarity, WindowLargerThanImage) {
+  const int cols = 9, rows = 7;  // kernel 31x31 for sigma = 5
+  const cv::Mat I1 = RandomImage(cols, rows, 34), I2 = RandomImage(cols, rows, 35);
+  const cv::Mat mask = TestMask(cols, rows);
+  const SimilarityOptions o = DoubleOptions("zncc", 5.0, 0);
+  const SimilarityResult res = ComputeSimilarity(I1, I2, mask, o);
+  const Reference ref = BruteStatistics(I1, I2, mask, o.sigma, o.epsilon);
+  for (int r = 0; r < rows; ++r)
+    for (int c = 0; c < cols; ++c) {
+      if (mask.at<uchar>(r, c) == 0) continue;
+      EXPECT_NEAR(res.zncc.at<double>(r, c), ref.m.at<double>(r, c), 1e-10) << r << " " << c;
+    }
+  double err = 0;
+  CheckGradientByFiniteDifferences(I1, I2, mask, o, &err);
+}
+
 TEST(Similarity, GradientMatchesFiniteDifferences) {
   const int cols = 24, rows = 20;
   const cv::Mat I1 = RandomImage(cols, rows, 5), I2 = RandomImage(cols, rows, 6);
