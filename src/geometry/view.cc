@@ -10,15 +10,16 @@
 namespace mr {
 
 PinholeView PinholeView::Scaled(double scale) const {
+  // Continuous image coordinates scale exactly by `scale`; the pixel count
+  // rounds up (a half-resolution pyramid level of an odd size n has
+  // (n + 1) / 2 pixels, as DownsampleHalf makes it).
   PinholeView v = *this;
-  v.width = static_cast<int>(std::lround(width * scale));
-  v.height = static_cast<int>(std::lround(height * scale));
-  const double sx = static_cast<double>(v.width) / width;
-  const double sy = static_cast<double>(v.height) / height;
-  v.fx *= sx;
-  v.cx *= sx;
-  v.fy *= sy;
-  v.cy *= sy;
+  v.width = static_cast<int>(std::ceil(width * scale - 1e-9));
+  v.height = static_cast<int>(std::ceil(height * scale - 1e-9));
+  v.fx *= scale;
+  v.cx *= scale;
+  v.fy *= scale;
+  v.cy *= scale;
   return v;
 }
 

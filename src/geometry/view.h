@@ -33,7 +33,8 @@ struct PinholeView {
     return p.x() >= 0 && p.y() >= 0 && p.x() < width && p.y() < height;
   }
   // The same view at `scale` times the resolution (a pyramid level is
-  // Scaled(0.5)); continuous image coordinates scale exactly.
+  // Scaled(0.5)); continuous image coordinates scale exactly, the pixel
+  // count rounds up.
   PinholeView Scaled(double scale) const;
 };
 

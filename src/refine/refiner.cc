@@ -66,7 +66,7 @@ class RenderCache {
 std::vector<PinholeView> ScaledViews(const ViewSource& source, int level) {
   std::vector<PinholeView> views;
   for (int i = 0; i < source.NumViews(); ++i) {
-    views.push_back(level == 0 ? source.View(i) : source.View(i).Scaled(std::ldexp(1.0, -level)));
+    views.push_back(PyramidLevelView(source.View(i), level));
   }
   return views;
 }

@@ -98,7 +98,7 @@ template <typename T>
 void SimilarityOneChannel(const cv::Mat& I1, const cv::Mat& I2, const cv::Mat& M,
                           const GaussianFilter& G, const SimilarityOptions& options,
                           bool compute_gradient, SimilarityResult* result, cv::Mat* zncc,
-                          cv::Mat* gradient) {
+                          cv::Mat* gradient, cv::Mat* variance2) {
   const int rows = I1.rows, cols = I1.cols;
   const int type6 = CV_MAKETYPE(cv::DataType<T>::depth, 6);
   const T eps = static_cast<T>(options.epsilon);
@@ -156,12 +156,14 @@ void SimilarityOneChannel(const cv::Mat& I1, const cv::Mat& I2, const cv::Mat& M
     const T* m = M.ptr<T>(r);
     const T* fs = Fs.ptr<T>(r);
     T* z = zncc->ptr<T>(r);
+    T* v2out = variance2->ptr<T>(r);
     T* b = compute_gradient ? R.ptr<T>(r) : nullptr;
     for (int c = 0; c < cols; ++c, fs += 6) {
       const T omega = fs[0];
       const T W = m[c];
       if (!(W > 0) || !(omega > 0) || omega < min_support) {
         z[c] = 0;
+        v2out[c] = eps;
         if (b) std::fill(b + c * nb, b + (c + 1) * nb, T(0));
         continue;
       }
@@ -174,6 +176,7 @@ void SimilarityOneChannel(const cv::Mat& I1, const cv::Mat& I2, const cv::Mat& M
       const T inv_s = T(1) / std::sqrt(v1 * v2);
       const T zn = v12 * inv_s;
       z[c] = zn;
+      v2out[c] = v2;
       cost += static_cast<double>(W) * (1.0 - static_cast<double>(zn));
       zsum += static_cast<double>(W) * zn;
       wsum += W;
@@ -229,19 +232,22 @@ SimilarityResult ComputeTyped(const cv::Mat& observed, const cv::Mat& predicted,
     cv::split(I2, ch2);
   }
   const int cn = static_cast<int>(ch1.size());
-  std::vector<cv::Mat> z(cn), g(cn);
+  std::vector<cv::Mat> z(cn), g(cn), v(cn);
   SimilarityResult result;
   for (int k = 0; k < cn; ++k) {
     z[k].create(I1.size(), depth);
+    v[k].create(I1.size(), depth);
     if (compute_gradient) g[k].create(I1.size(), depth);
     SimilarityOneChannel<T>(ch1[k], ch2[k], M, G, options, compute_gradient, &result, &z[k],
-                            &g[k]);
+                            &g[k], &v[k]);
   }
   if (cn == 1) {
     result.zncc = z[0];
+    result.variance_predicted = v[0];
     if (compute_gradient) result.gradient = g[0];
   } else {
     cv::merge(z, result.zncc);
+    cv::merge(v, result.variance_predicted);
     if (compute_gradient) cv::merge(g, result.gradient);
   }
   return result;

@@ -75,6 +75,10 @@ struct SimilarityResult {
   // Per-pixel m(p) (0 where W(p) = 0), same size and channel count as the
   // images, CV_32F (CV_64F with double_precision).
   cv::Mat zncc;
+  // Per-pixel local variance v_2 of the predicted image (eq. De2, including
+  // eps; eps where W(p) = 0), same size, channels and depth as `zncc`. The
+  // refiner's Gauss-Newton curvature uses 1 / v_2.
+  cv::Mat variance_predicted;
   // Per-pixel dC/dI2 ("zncc") or the paper's modified direction ("dcv"), same
   // size, channels and depth as `zncc`; 0 where M = 0. Empty unless
   // compute_gradient.

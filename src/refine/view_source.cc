@@ -84,12 +84,15 @@ cv::Mat ImageCache::Get(int kind, int i, int level) {
     const cv::Mat finer = Get(kind, i, level - 1);
     if (!finer.empty()) {
       if (kind == 0) {
-        image = DownsampleGaussian(finer);
+        image = DownsampleHalf(finer);
       } else {
         // A mask pixel stays foreground if any of its 2x2 parents is.
         cv::Mat f, d;
         finer.convertTo(f, CV_32F);
-        cv::resize(f, d, cv::Size(finer.cols / 2, finer.rows / 2), 0, 0, cv::INTER_AREA);
+        // Pad odd sizes by one replicated row/column so that level sizes are
+        // (n + 1) / 2, as for the images.
+        cv::copyMakeBorder(f, f, 0, finer.rows % 2, 0, finer.cols % 2, cv::BORDER_REPLICATE);
+        cv::resize(f, d, cv::Size(f.cols / 2, f.rows / 2), 0, 0, cv::INTER_AREA);
         image = d > 0;
       }
     }
