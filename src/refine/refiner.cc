@@ -87,14 +87,9 @@ void RemeshForLevel(const std::vector<PinholeView>& views, const RefineOptions& 
   if (faces_before > 2 * target_faces) {
     // Large reductions by quadric decimation first (Garland-Heckbert), which
     // keeps the shape better than collapsing to length alone.
-    DecimateOptions decimate;
-    decimate.target_faces = std::max(4, target_faces);
-    Decimate(V, F, decimate);
+    MR_LOG(VERBOSE) << Decimate(V, F, std::max(4, target_faces)).BriefReport();
   }
-  IsotropicRemeshOptions remesh;
-  remesh.target_edge_length = edge;
-  remesh.iterations = 3;
-  IsotropicRemesh(V, F, remesh);
+  MR_LOG(VERBOSE) << IsotropicRemesh(V, F, edge).BriefReport();
   MR_LOG(INFO) << "Remeshed " << faces_before << " -> " << F->rows() << " faces (edge "
                << edge / footprint << " px at this level, " << ElapsedSeconds() - t0 << " s)";
 }
@@ -249,9 +244,13 @@ RefineSummary RefineMesh(const ViewSource& source, const RefineOptions& options,
   Eigen::MatrixXd V = mesh->V;
   Eigen::MatrixXi F = mesh->F;
 
-  CleanMeshReport clean = CleanMesh(&V, &F);
-  if (clean.Changed()) MR_LOG(INFO) << "Cleaned input mesh: " << clean.ToString();
+  const CleanMeshReport clean = CleanMesh(&V, &F);
+  MR_LOG(INFO) << "Input mesh: " << clean.BriefReport();
   if (F.rows() == 0) MR_THROW_INPUT << "the input mesh has no valid faces after cleaning";
+  if (!clean.IsCleanManifold()) {
+    MR_THROW_INPUT << "the input mesh could not be made an oriented 2-manifold ("
+                   << clean.BriefReport() << ")";
+  }
 
   const std::vector<PinholeView> full_views = source.Views();
   const auto neighbors = SelectNeighbors(full_views, V, VertexNormals(V, F), options.view_selection);
@@ -294,6 +293,7 @@ RefineSummary RefineMesh(const ViewSource& source, const RefineOptions& options,
                          : 0.0;
       similarity.kappa = record.kappa;
 
+      const Eigen::MatrixXd V_before = V;
       renderer->SetMesh(V, F);
       renders.Invalidate();
       MeshGeometry geometry{&V, &F, FaceNormals(V, F)};
@@ -350,7 +350,7 @@ RefineSummary RefineMesh(const ViewSource& source, const RefineOptions& options,
       } else {
         V = V_half;
       }
-      summary.flipped_faces_fixed += FixFlippedFaces(V_half, &V, F);
+      summary.flipped_faces_fixed += FixFlippedFaces(V_before, F, &V).initial_flipped;
 
       record.seconds = ElapsedSeconds() - t_iter;
       MR_LOG(INFO) << "Level " << level << " iteration " << it + 1 << "/"
@@ -375,7 +375,14 @@ RefineSummary RefineMesh(const ViewSource& source, const RefineOptions& options,
   }
   summary.initial_similarity =
       summary.iterations.empty() ? summary.final_similarity : summary.iterations.front().mean_similarity;
-  summary.self_intersections = CountSelfIntersections(V, F);
+  // Leave no self-intersection behind (the flow can fold thin parts).
+  const SelfIntersectionReport intersections = CountSelfIntersections(V, F);
+  summary.self_intersections = static_cast<int>(intersections.intersecting_pairs);
+  if (intersections.intersecting_pairs > 0) {
+    const RemoveSelfIntersectionsSummary repair = RemoveSelfIntersections(&V, &F);
+    MR_LOG(INFO) << "Self-intersections: " << repair.BriefReport();
+    summary.self_intersections = static_cast<int>(repair.final_pairs);
+  }
   mesh->V = V;
   mesh->F = F;
   mesh->N.resize(0, 3);
