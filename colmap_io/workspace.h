@@ -8,7 +8,11 @@
 // meshed-delaunay.ply. A sparse workspace (a project folder with images/ and
 // sparse/0 in a distorted model) is undistorted first, into
 // <workspace>/mesh_refiner_undistorted/, which is then opened as a dense
-// workspace; the log says how.
+// workspace; the log and Workspace::undistortion say how. A complete earlier
+// undistortion of the same model and folders is reused; a folder of that name
+// not written by mesh_refiner is never overwritten (InputError).
+// The sparse model is looked for in <workspace>/sparse, then in the
+// lowest-numbered <workspace>/sparse/<n>.
 
 #include <string>
 #include <vector>
@@ -20,8 +24,10 @@
 namespace mr {
 
 struct WorkspaceOptions {
-  // Folder of masks named "<image name>.png" (COLMAP's convention); empty:
-  // use <workspace>/masks if it exists, else no masks.
+  // Folder of masks named "<image name>.png" (COLMAP's convention:
+  // images/a.jpg -> masks/a.jpg.png); must exist if set. Empty: use
+  // <workspace>/masks, else <workspace>/stereo/masks, if it exists, else no
+  // masks. Masks of a distorted sparse project are undistorted with it.
   std::string mask_path;
   // Folder of the images; empty: <workspace>/images.
   std::string image_path;
