@@ -2,6 +2,7 @@
 
 #include <cmath>
 #include <cstdio>
+#include <filesystem>
 #include <iomanip>
 #include <limits>
 #include <sstream>
@@ -104,8 +105,21 @@ std::string UndistortionFingerprint(const std::string& image_dir, const std::str
     for (double p : camera.params) s << " " << p;
     s << "\n";
   }
+  // Sizes and modification times of the source files, so replaced images or
+  // masks are undistorted again.
+  auto stamp = [&](const std::string& path) {
+    std::error_code ec;
+    const auto size = std::filesystem::file_size(path, ec);
+    if (ec) return std::string("-");
+    const auto time = std::filesystem::last_write_time(path, ec);
+    if (ec) return std::string("-");
+    return std::to_string(size) + "@" + std::to_string(time.time_since_epoch().count());
+  };
   for (const auto& [id, image] : model.images) {
-    s << "image " << id << " " << image.camera_id << " " << image.name << "\n";
+    s << "image " << id << " " << image.camera_id << " " << image.name << " "
+      << stamp(JoinPaths(image_dir, image.name));
+    if (!mask_dir.empty()) s << " mask " << stamp(JoinPaths(mask_dir, image.name + ".png"));
+    s << "\n";
   }
   return s.str();
 }
@@ -140,6 +154,16 @@ UndistortionSummary UndistortSparseModel(const std::string& image_dir,
                                          const std::string& output_dir,
                                          const UndistortionOptions& options) {
   options.Check();
+  // Image names become paths below output_dir: refuse any that would escape it.
+  for (const auto& [id, image] : model.images) {
+    const std::filesystem::path name(image.name);
+    bool escapes = name.is_absolute() || name.empty();
+    for (const auto& part : name) escapes = escapes || part == "..";
+    if (escapes) {
+      MR_THROW_INPUT << "image " << id << " has the name '" << image.name
+                     << "', which is not a relative path inside the image folder";
+    }
+  }
   // Validate every camera before writing anything.
   std::map<uint32_t, std::pair<cv::Mat, cv::Mat>> maps;
   Reconstruction out_model;

@@ -197,5 +197,25 @@ TEST(Undistortion, WrongImageSize) {
   }
 }
 
+TEST(Undistortion, RefusesEscapingImageNames) {
+  TempDir dir("undistort_names");
+  Reconstruction model;
+  model.cameras[1] = MakeCamera(CameraModel::kSimpleRadial, {250, 160, 120, -0.08});
+  Image image;
+  image.image_id = 1;
+  image.camera_id = 1;
+  for (const std::string name : {"../evil.png", "/abs.png", "a/../../b.png"}) {
+    image.name = name;
+    model.images[1] = image;
+    try {
+      UndistortSparseModel(dir.path(), "", model, dir.path() + "/out");
+      ADD_FAILURE() << "no InputError for " << name;
+    } catch (const InputError& e) {
+      EXPECT_NE(std::string(e.what()).find(name), std::string::npos) << e.what();
+    }
+  }
+  EXPECT_FALSE(ExistsDir(dir.path() + "/out"));
+}
+
 }  // namespace
 }  // namespace mr

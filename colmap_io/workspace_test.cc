@@ -1,6 +1,8 @@
 #include "colmap_io/workspace.h"
 
+#include <chrono>
 #include <filesystem>
+#include <thread>
 #include <fstream>
 
 #include <gtest/gtest.h>
@@ -149,6 +151,12 @@ TEST(Workspace, DistortedSparseProjectIsUndistorted) {
 
   // A changed model is undistorted again.
   WriteSparseModelBinary(root + "/sparse/0", DistortedModel(-0.07));
+  ws = OpenWorkspace(root);
+  EXPECT_NE(ws.undistortion.find("undistorted 3 images"), std::string::npos) << ws.undistortion;
+
+  // Replaced source images are undistorted again.
+  std::this_thread::sleep_for(std::chrono::milliseconds(20));
+  ASSERT_TRUE(cv::imwrite(root + "/images/a.png", cv::Mat(48, 64, CV_8UC3, cv::Scalar(1, 2, 3))));
   ws = OpenWorkspace(root);
   EXPECT_NE(ws.undistortion.find("undistorted 3 images"), std::string::npos) << ws.undistortion;
 
