@@ -211,6 +211,26 @@ TEST(Workspace, MasksOfDistortedProjectAreUndistorted) {
   EXPECT_TRUE(ws.ReadMask(1).empty());
 }
 
+TEST(Workspace, LowestNumberedSparseModel) {
+  TempDir dir("ws_sparse_numbered");
+  const std::string root = MakeWorkspace(dir, PinholeModel(), "sparse/3");
+  Reconstruction other = PinholeModel();
+  other.images.erase(3);
+  WriteSparseModelBinary(dir.Sub("sparse/12"), other);
+  dir.Sub("sparse/1");  // empty: ignored
+  EXPECT_EQ(OpenWorkspace(root).sparse_dir, root + "/sparse/3");
+}
+
+TEST(Workspace, StereoMasksFallback) {
+  TempDir dir("ws_stereo_masks");
+  const std::string root = MakeWorkspace(dir, PinholeModel(), "sparse");
+  const std::string masks = dir.Sub("stereo/masks");
+  ASSERT_TRUE(cv::imwrite(masks + "/c.png.png", cv::Mat(48, 64, CV_8UC1, cv::Scalar(7))));
+  const Workspace ws = OpenWorkspace(root);
+  EXPECT_EQ(ws.mask_dir, masks);
+  EXPECT_EQ(ws.ReadMask(1).at<uint8_t>(0, 0), 7);
+}
+
 TEST(Workspace, MissingFolder) {
   ExpectInputError([&] { OpenWorkspace("/nonexistent/ws"); },
                    {"/nonexistent/ws", "workspace folder does not exist"});
