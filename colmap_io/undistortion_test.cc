@@ -1,6 +1,7 @@
 #include "colmap_io/undistortion.h"
 
 #include <cmath>
+#include <cstdlib>
 #include <iostream>
 
 #include <gtest/gtest.h>
@@ -194,6 +195,81 @@ TEST(Undistortion, WrongImageSize) {
     ADD_FAILURE() << "no InputError";
   } catch (const InputError& e) {
     EXPECT_NE(std::string(e.what()).find("100x100"), std::string::npos) << e.what();
+  }
+}
+
+// Independent check: COLMAP's own image_undistorter (scale fixed to 1, so it
+// keeps size, focal lengths and principal point) produces the same images
+// and 2-D points from the same distorted project.
+TEST(Undistortion, MatchesColmapImageUndistorter) {
+  if (std::string(MR_COLMAP_EXECUTABLE).empty()) GTEST_SKIP() << "colmap not found";
+  TempDir dir("undistort_colmap");
+  const std::string images = dir.Sub("images"), sparse = dir.Sub("sparse");
+  const std::vector<std::pair<CameraModel, std::vector<double>>> cameras = {
+      {CameraModel::kOpenCV, {250, 255, 165.5, 117.25, -0.1, 0.02, 0.002, -0.003}},
+      {CameraModel::kOpenCVFisheye, {200, 202, 158, 122, 0.05, -0.01, 0.002, -0.0005}},
+      {CameraModel::kFullOpenCV,
+       {250, 255, 161, 119, -0.1, 0.02, 0.002, -0.003, 0.001, 0.01, -0.005, 0.001}},
+      {CameraModel::kThinPrismFisheye,
+       {200, 202, 160, 120, 0.05, -0.01, 0.001, -0.001, 0.002, -0.0005, 0.001, -0.001}},
+  };
+  Reconstruction model;
+  cv::RNG rng(11);
+  for (size_t i = 0; i < cameras.size(); ++i) {
+    Camera camera = MakeCamera(cameras[i].first, cameras[i].second);
+    camera.camera_id = static_cast<uint32_t>(i + 1);
+    model.cameras[camera.camera_id] = camera;
+    Image image;
+    image.image_id = camera.camera_id;
+    image.camera_id = camera.camera_id;
+    image.name = "img" + std::to_string(i) + ".png";
+    image.tvec = Eigen::Vector3d(0.1 * i, 0, 0);
+    Point2D p;
+    p.xy = Eigen::Vector2d(30.25 + 20 * i, 200.5 - 10 * i);
+    image.points2D.push_back(p);
+    model.images[image.image_id] = image;
+    // A smooth random texture.
+    cv::Mat noise(240, 320, CV_32FC3), texture;
+    rng.fill(noise, cv::RNG::UNIFORM, 0, 255);
+    cv::GaussianBlur(noise, texture, cv::Size(0, 0), 2.0);
+    cv::normalize(texture, texture, 0, 255, cv::NORM_MINMAX);
+    texture.convertTo(texture, CV_8UC3);
+    ASSERT_TRUE(cv::imwrite(images + "/" + image.name, texture));
+  }
+  WriteSparseModelBinary(sparse, model);
+  const std::string ours = dir.path() + "/ours", theirs = dir.path() + "/theirs";
+  UndistortSparseModel(images, "", model, ours);
+  const std::string cmd = std::string("QT_QPA_PLATFORM=offscreen ") + MR_COLMAP_EXECUTABLE +
+                          " image_undistorter --image_path " + images + " --input_path " +
+                          sparse + " --output_path " + theirs +
+                          " --min_scale 1 --max_scale 1 > /dev/null 2>&1";
+  ASSERT_EQ(std::system(cmd.c_str()), 0);
+  const Reconstruction a = ReadSparseModelBinary(ours + "/sparse");
+  const Reconstruction b = ReadSparseModel(theirs + "/sparse");
+  for (const auto& [id, image] : a.images) {
+    const Camera& ca = a.cameras.at(image.camera_id);
+    const Camera& cb = b.cameras.at(b.images.at(id).camera_id);
+    ASSERT_EQ(cb.width, ca.width);
+    ASSERT_EQ(cb.height, ca.height);
+    EXPECT_NEAR(CameraFocalX(cb.model, cb.params), ca.params[0], 1e-9);
+    EXPECT_NEAR(CameraFocalY(cb.model, cb.params), ca.params[1], 1e-9);
+    EXPECT_NEAR(CameraPrincipalX(cb.model, cb.params), ca.params[2], 1e-9);
+    EXPECT_NEAR(CameraPrincipalY(cb.model, cb.params), ca.params[3], 1e-9);
+    EXPECT_LT((image.points2D[0].xy - b.images.at(id).points2D[0].xy).norm(), 1e-6);
+    const cv::Mat ia = cv::imread(ours + "/images/" + image.name, cv::IMREAD_COLOR);
+    const cv::Mat ib = cv::imread(theirs + "/images/" + image.name, cv::IMREAD_COLOR);
+    ASSERT_EQ(ia.size(), ib.size());
+    const cv::Rect inner(10, 10, ia.cols - 20, ia.rows - 20);
+    cv::Mat diff;
+    cv::absdiff(ia(inner), ib(inner), diff);
+    const cv::Scalar mean = cv::mean(diff);
+    double max_diff = 0;
+    cv::minMaxLoc(diff.reshape(1), nullptr, &max_diff);
+    const std::string what = CameraModelName(model.cameras.at(image.camera_id).model);
+    EXPECT_LT((mean[0] + mean[1] + mean[2]) / 3, 0.25) << what;
+    EXPECT_LE(max_diff, 2) << what;
+    std::cout << what << ": mean |ours - colmap| " << (mean[0] + mean[1] + mean[2]) / 3
+              << ", max " << max_diff << " gray levels\n";
   }
 }
 
