@@ -2,6 +2,9 @@
 
 #include <cmath>
 
+#include <Eigen/Geometry>
+#include <Eigen/LU>
+
 #include "util/error.h"
 
 namespace mr {
@@ -16,6 +19,26 @@ PinholeView PinholeView::Scaled(double scale) const {
   v.cx *= sx;
   v.fy *= sy;
   v.cy *= sy;
+  return v;
+}
+
+PinholeView LookAtView(const Eigen::Vector3d& center, const Eigen::Vector3d& target,
+                       const Eigen::Vector3d& up, int width, int height, double focal) {
+  const Eigen::Vector3d z = (target - center).normalized();
+  Eigen::Vector3d y = -up + up.dot(z) * z;  // image y points down
+  MR_CHECK(y.norm() > 1e-9) << "LookAtView: up is parallel to the viewing direction";
+  y.normalize();
+  const Eigen::Vector3d x = y.cross(z);
+  PinholeView v;
+  v.width = width;
+  v.height = height;
+  v.fx = v.fy = focal;
+  v.cx = width / 2.0;
+  v.cy = height / 2.0;
+  v.R.row(0) = x.transpose();
+  v.R.row(1) = y.transpose();
+  v.R.row(2) = z.transpose();
+  v.t = -v.R * center;
   return v;
 }
 

@@ -37,6 +37,11 @@ struct PinholeView {
   PinholeView Scaled(double scale) const;
 };
 
+// A view at `center` looking at `target`, with the image's up direction
+// closest to `up` (world); principal point at the image centre.
+PinholeView LookAtView(const Eigen::Vector3d& center, const Eigen::Vector3d& target,
+                       const Eigen::Vector3d& up, int width, int height, double focal);
+
 // The pinhole view of a registered image. Throws InputError if the camera is
 // not PINHOLE or SIMPLE_PINHOLE (undistort first).
 PinholeView ViewFromColmap(const Camera& camera, const Image& image);
