@@ -183,9 +183,15 @@ std::string Workspace::MaskPath(uint32_t image_id) const {
 }
 
 std::string Workspace::DefaultMeshPath() const {
-  for (const char* name : {"meshed-poisson.ply", "meshed-delaunay.ply"}) {
-    const std::string path = JoinPaths(root, name);
-    if (ExistsFile(path)) return path;
+  // After undistortion `root` is <project>/mesh_refiner_undistorted; the
+  // project's own meshes (same world frame) are looked for next.
+  std::vector<std::string> dirs = {root};
+  if (!undistortion.empty()) dirs.push_back(GetParentDir(root));
+  for (const std::string& dir : dirs) {
+    for (const char* name : {"meshed-poisson.ply", "meshed-delaunay.ply"}) {
+      const std::string path = JoinPaths(dir, name);
+      if (ExistsFile(path)) return path;
+    }
   }
   return "";
 }

@@ -47,7 +47,8 @@ struct Workspace {
   std::string ImagePath(uint32_t image_id) const;
   // Path of the mask of an image, or "" if there is none.
   std::string MaskPath(uint32_t image_id) const;
-  // meshed-poisson.ply if present, else meshed-delaunay.ply, else "".
+  // meshed-poisson.ply if present, else meshed-delaunay.ply, else "";
+  // looked for in `root`, then (after undistortion) in the project folder.
   std::string DefaultMeshPath() const;
   // Reads an image (8-bit; grayscale or BGR). Throws InputError if missing or
   // if its size differs from its camera's.

@@ -143,6 +143,11 @@ TEST(Workspace, DistortedSparseProjectIsUndistorted) {
   // The user's files are untouched.
   EXPECT_EQ(ReadSparseModel(root + "/sparse/0").cameras.at(1).model, CameraModel::kSimpleRadial);
 
+  // The project's own mesh is the default mesh.
+  EXPECT_EQ(ws.DefaultMeshPath(), "");
+  std::ofstream(root + "/meshed-poisson.ply") << "ply";
+  EXPECT_EQ(ws.DefaultMeshPath(), root + "/meshed-poisson.ply");
+
   // Opening again reuses the complete output.
   const auto stamp = fs::last_write_time(out + "/images/a.png");
   ws = OpenWorkspace(root);
