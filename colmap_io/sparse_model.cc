@@ -1,5 +1,6 @@
 #include "colmap_io/sparse_model.h"
 
+#include <cerrno>
 #include <cmath>
 #include <cstring>
 #include <iomanip>
@@ -122,7 +123,7 @@ CameraModel ModelFromId(const std::string& path, uint32_t camera_id, int64_t mod
 
 class BinaryCursor {
  public:
-  BinaryCursor(std::string path) : path_(std::move(path)), data_(ReadFileToString(path_)) {}
+  explicit BinaryCursor(std::string path) : path_(std::move(path)), data_(ReadFileToString(path_)) {}
 
   size_t Remaining() const { return data_.size() - pos_; }
 
