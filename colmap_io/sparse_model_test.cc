@@ -318,6 +318,44 @@ TEST(SparseModel, TextImagesWithoutPointsLines) {
   EXPECT_EQ(model.images.at(2).tvec.z(), 1.0);
 }
 
+// Random byte corruption either still parses or throws InputError; never
+// anything else (no crash, no internal error, no huge allocation).
+TEST(SparseModel, RandomCorruptionOnlyThrowsInputError) {
+  TempDir dir("sparse_fuzz");
+  const Reconstruction model = MakeModelWithAllCameraModels();
+  std::mt19937 rng(17);
+  int input_errors = 0;
+  for (const bool text : {false, true}) {
+    if (text) {
+      WriteSparseModelText(dir.path(), model);
+    } else {
+      WriteSparseModelBinary(dir.path(), model);
+    }
+    for (const std::string base : {"cameras", "images", "points3D"}) {
+      const std::string path = dir.path() + "/" + base + (text ? ".txt" : ".bin");
+      const std::string original = ReadFileToString(path);
+      for (int trial = 0; trial < 60; ++trial) {
+        std::string corrupt = original;
+        const int flips = 1 + static_cast<int>(rng() % 4);
+        for (int f = 0; f < flips; ++f) {
+          corrupt[rng() % corrupt.size()] = text ? "0123456789.-e #\nxn"[rng() % 17]
+                                                 : static_cast<char>(rng());
+        }
+        WriteString(path, corrupt);
+        try {
+          text ? ReadSparseModelText(dir.path()) : ReadSparseModelBinary(dir.path());
+        } catch (const InputError&) {
+          ++input_errors;
+        } catch (const std::exception& e) {
+          ADD_FAILURE() << path << " trial " << trial << ": unexpected " << e.what();
+        }
+      }
+      WriteString(path, original);
+    }
+  }
+  EXPECT_GT(input_errors, 120) << input_errors << " of 360";
+}
+
 TEST(SparseModel, DuplicateIds) {
   TempDir dir("sparse_dup");
   WriteString(dir.path() + "/cameras.txt",
