@@ -89,10 +89,11 @@ bool IsDegenerate(const Eigen::MatrixXd& V, const Eigen::MatrixXi& F, int f, dou
 // connected through edges with exactly two faces). With `fix`, each extra fan
 // gets its own copy of the vertex (appended to V). Returns the number of such
 // vertices; *num_copies receives the number of copies added.
-int ProcessVertexFans(Eigen::MatrixXd* V, Eigen::MatrixXi* F, bool fix, int* num_copies) {
+// `topo` is the edge topology of (V, F).
+int ProcessVertexFans(const EdgeTopology& topo, Eigen::MatrixXd* V, Eigen::MatrixXi* F, bool fix,
+                      int* num_copies) {
   *num_copies = 0;
   const int nv = V->rows();
-  const EdgeTopology topo = ComputeEdgeTopology(*F, nv);
   std::vector<int> start(nv + 1, 0);
   for (int f = 0; f < F->rows(); ++f)
     for (int k = 0; k < 3; ++k) ++start[(*F)(f, k) + 1];
@@ -108,8 +109,6 @@ int ProcessVertexFans(Eigen::MatrixXd* V, Eigen::MatrixXi* F, bool fix, int* num
     const int n = start[v + 1] - start[v];
     if (n <= 1) continue;
     const int* faces = vf.data() + start[v];
-    std::unordered_map<int, int> local;
-    for (int i = 0; i < n; ++i) local[faces[i]] = i;
     UnionFind uf(n);
     for (int i = 0; i < n; ++i) {
       const int f = faces[i];
@@ -118,15 +117,16 @@ int ProcessVertexFans(Eigen::MatrixXd* V, Eigen::MatrixXi* F, bool fix, int* num
         const std::vector<int>& ef = topo.edge_faces[topo.face_edges(f, k)];
         if (ef.size() != 2) continue;  // boundary or non-manifold: a cut
         const int g = ef[0] == f ? ef[1] : ef[0];
-        const auto it = local.find(g);
-        if (it != local.end()) uf.Union(i, it->second);
+        const int j = static_cast<int>(std::find(faces, faces + n, g) - faces);
+        if (j < n) uf.Union(i, j);
       }
     }
-    std::unordered_map<int, int> group_vertex;  // root -> vertex index
-    for (int i = 0; i < n; ++i) group_vertex.emplace(uf.Find(i), -1);
-    if (group_vertex.size() <= 1) continue;
+    bool single = true;
+    for (int i = 1; i < n && single; ++i) single = uf.Find(i) == uf.Find(0);
+    if (single) continue;
     ++bad;
     if (!fix) continue;
+    std::vector<int> group_vertex(n, -1);  // root (local index) -> vertex index
     bool first = true;
     for (int i = 0; i < n; ++i) {
       int& target = group_vertex[uf.Find(i)];
@@ -403,12 +403,28 @@ CleanMeshReport CleanMesh(Eigen::MatrixXd* V, Eigen::MatrixXi* F, const CleanMes
   r.removed_unreferenced_vertices = RemoveUnreferencedKeepOrder(V, F);
   if (V->rows() == 0) V->resize(0, 3);
 
+  MR_LOG(VERBOSE) << "CleanMesh: merge/degenerate/duplicate/unreferenced done, "
+                  << ElapsedSeconds() - t0 << " s";
+
   // 6. Non-manifold edges and vertices.
-  r.non_manifold_edges = ComputeEdgeTopology(*F, V->rows()).NumNonManifoldEdges();
-  r.non_manifold_vertices = ProcessVertexFans(V, F, options.fix_non_manifold, &r.split_vertices);
+  EdgeTopology topo = ComputeEdgeTopology(*F, V->rows());
+  r.non_manifold_edges = topo.NumNonManifoldEdges();
+  r.non_manifold_vertices =
+      ProcessVertexFans(topo, V, F, options.fix_non_manifold, &r.split_vertices);
+  // Splitting can make a former non-manifold edge manifold and so change the
+  // fans of its end points: repeat until stable (a few passes at most).
+  for (int pass = 0; pass < 10 && r.split_vertices > 0; ++pass) {
+    topo = ComputeEdgeTopology(*F, V->rows());
+    int copies = 0;
+    const int more = ProcessVertexFans(topo, V, F, true, &copies);
+    MR_LOG(VERBOSE) << "CleanMesh: non-manifold pass " << pass + 2 << ": " << more
+                    << " vertices";
+    if (more == 0) break;
+    r.split_vertices += copies;
+  }
+  MR_LOG(VERBOSE) << "CleanMesh: non-manifold check done, " << ElapsedSeconds() - t0 << " s";
 
   // 7. Orientation, per component over manifold edges, majority kept.
-  EdgeTopology topo = ComputeEdgeTopology(*F, V->rows());
   {
     const int nf = F->rows();
     std::vector<int> component(nf, -1);
@@ -456,15 +472,18 @@ CleanMeshReport CleanMesh(Eigen::MatrixXd* V, Eigen::MatrixXi* F, const CleanMes
     for (int f = 0; f < nf; ++f) {
       if (flip[f]) {
         std::swap((*F)(f, 1), (*F)(f, 2));
+        std::swap(topo.face_edges(f, 1), topo.face_edges(f, 2));  // keep topo valid
         ++r.reoriented_faces;
       }
     }
   }
 
+  MR_LOG(VERBOSE) << "CleanMesh: orientation done, " << ElapsedSeconds() - t0 << " s";
+
   // 8. Final state.
   r.remaining_non_manifold_edges = topo.NumNonManifoldEdges();
   int unused = 0;
-  r.remaining_non_manifold_vertices = ProcessVertexFans(V, F, false, &unused);
+  r.remaining_non_manifold_vertices = ProcessVertexFans(topo, V, F, false, &unused);
   r.inconsistent_edges = CountInconsistentEdges(*F, topo);
   r.boundary_edges = topo.NumBoundaryEdges();
   r.final_vertices = V->rows();

@@ -2,7 +2,9 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
+#include <cstdlib>
 #include <limits>
 
 #include "geometry/mesh.h"
@@ -377,6 +379,63 @@ TEST(Remesh, EmptyMesh) {
   Eigen::MatrixXi F0;
   EXPECT_NO_THROW(CleanMesh(&V0, &F0));
   EXPECT_NO_THROW(SubdivideMidpoint(&V0, &F0));
+}
+
+TEST(Remesh, RandomSoupsNeverCrash) {
+  // Random triangle soups (with repeated indices, duplicates, coincident
+  // points, non-manifold edges): CleanMesh must make them usable, and the
+  // CGAL functions must either work or throw InputError.
+  std::srand(7);
+  int usable = 0;
+  for (int trial = 0; trial < 20; ++trial) {
+    const int nv = 10 + trial * 3, nf = 3 * nv;
+    Eigen::MatrixXd V = Eigen::MatrixXd::Random(nv, 3);
+    for (int v = 0; v < nv; v += 7) V.row(v) = V.row(0);  // exact duplicates
+    Eigen::MatrixXi F(nf, 3);
+    for (int f = 0; f < nf; ++f)
+      for (int k = 0; k < 3; ++k) F(f, k) = std::rand() % nv;
+    const CleanMeshReport r = CleanMesh(&V, &F);
+    EXPECT_EQ(r.remaining_non_manifold_edges, 0) << "trial " << trial;
+    EXPECT_EQ(r.remaining_non_manifold_vertices, 0) << "trial " << trial;
+    if (!r.IsCleanManifold()) continue;  // a non-orientable component
+    ++usable;
+    const double edge = MeanEdgeLength(V, F);
+    auto run = [&](auto&& fn) {
+      Eigen::MatrixXd W = V;
+      Eigen::MatrixXi G = F;
+      try {
+        fn(&W, &G);
+      } catch (const InputError&) {
+      }
+    };
+    run([&](Eigen::MatrixXd* W, Eigen::MatrixXi* G) { CountSelfIntersections(*W, *G); });
+    run([&](Eigen::MatrixXd* W, Eigen::MatrixXi* G) { Decimate(W, G, std::max(1, nf / 4)); });
+    run([&](Eigen::MatrixXd* W, Eigen::MatrixXi* G) { SubdivideSqrt3(W, G); });
+    run([&](Eigen::MatrixXd* W, Eigen::MatrixXi* G) { IsotropicRemesh(W, G, edge); });
+    run([&](Eigen::MatrixXd* W, Eigen::MatrixXi* G) { RemoveSelfIntersections(W, G); });
+  }
+  EXPECT_GE(usable, 10);  // the CGAL functions really ran on cleaned soups
+}
+
+TEST(SubdivideSqrt3, OpenMesh) {
+  Eigen::MatrixXd V;
+  Eigen::MatrixXi F;
+  Icosphere(2, &V, &F);
+  Eigen::MatrixXi H(F.rows(), 3);
+  int n = 0;
+  for (int f = 0; f < F.rows(); ++f) {
+    if (V(F(f, 0), 2) + V(F(f, 1), 2) + V(F(f, 2), 2) > 0) H.row(n++) = F.row(f);
+  }
+  H.conservativeResize(n, 3);
+  F = H;
+  RemoveUnreferencedVertices(&V, &F);
+  const int nb = ComputeEdgeTopology(F, V.rows()).NumBoundaryEdges();
+  ASSERT_GT(nb, 0);
+  SubdivideSqrt3(&V, &F);
+  EXPECT_GE(F.rows(), 3 * n);
+  const EdgeTopology topo = ComputeEdgeTopology(F, V.rows());
+  EXPECT_EQ(topo.NumNonManifoldEdges(), 0);
+  EXPECT_GE(topo.NumBoundaryEdges(), nb);
 }
 
 TEST(Remesh, NonManifoldInputToCgalThrows) {
