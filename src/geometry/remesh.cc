@@ -178,6 +178,10 @@ DecimateSummary Decimate(Eigen::MatrixXd* V, Eigen::MatrixXi* F, int target_face
   summary.target_not_reached = F->rows() > target_faces;
   summary.seconds = ElapsedSeconds() - t0;
   MR_LOG(INFO) << "Decimate: " << summary.BriefReport();
+  if (summary.target_not_reached) {
+    MR_LOG(WARNING) << "Decimate: stopped at " << summary.final_faces << " faces (target "
+                    << target_faces << "): no admissible collapse left";
+  }
   return summary;
 }
 

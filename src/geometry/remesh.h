@@ -32,8 +32,8 @@ struct DecimateOptions {
   // Cost/placement policy: "garland_heckbert" (plane quadrics, Garland &
   // Heckbert 1997; CGAL >= 5.5) or "lindstrom_turk" (Lindstrom & Turk 1998).
   std::string policy = "garland_heckbert";
-  // Reject collapses that turn a face normal by more than 90 degrees
-  // (CGAL Bounded_normal_change_filter): prevents folds.
+  // Reject a collapse if any face of the resulting star turns its normal by
+  // 90 degrees or more (CGAL Bounded_normal_change_filter): prevents folds.
   bool bounded_normal_change = true;
 
   bool Check() const;
