@@ -103,7 +103,7 @@ class Metric {
 };
 
 // Experiment-only overrides of the lp options from the environment (MAXIT,
-// FIXP, LSCALE, BMAX, B0, FIXL); unset = defaults. Results in docs/ use none.
+// FIXP, LSCALE, BMAX, B0, FIXL, BF, UPDOP); unset = defaults. Results in docs/ use none.
 void ApplyEnvOverrides(mr::DenoiseOptions* o) {
   auto env = [](const char* name, double fallback) {
     const char* v = std::getenv(name);
@@ -115,6 +115,8 @@ void ApplyEnvOverrides(mr::DenoiseOptions* o) {
   o->beta_max = env("BMAX", o->beta_max);
   o->beta_initial = env("B0", o->beta_initial);
   o->fixed_lambda = env("FIXL", o->fixed_lambda);
+  o->beta_factor = env("BF", o->beta_factor);
+  o->update_operator = env("UPDOP", o->update_operator ? 1 : 0) != 0;
 }
 
 double PeakMemoryMiB() {

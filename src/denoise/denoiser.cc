@@ -104,7 +104,7 @@ class NormalMatrix {
 };
 
 #ifdef MR_HAVE_CHOLMOD
-using Cholesky = Eigen::CholmodSimplicialLDLT<Eigen::SparseMatrix<double>, Eigen::Lower>;
+using Cholesky = Eigen::CholmodSupernodalLLT<Eigen::SparseMatrix<double>, Eigen::Lower>;
 #else
 using Cholesky = Eigen::SimplicialLDLT<Eigen::SparseMatrix<double>, Eigen::Lower>;
 #endif

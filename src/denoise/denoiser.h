@@ -59,7 +59,7 @@ struct DenoiseOptions {
   // Penalty continuation for the splitting, in units where the mean edge
   // length is 1: beta goes beta_initial, * beta_factor, ... up to beta_max.
   double beta_initial = 0.5;   // > 0
-  double beta_max = 1e3;       // >= beta_initial
+  double beta_max = 100;       // >= beta_initial
   double beta_factor = 2.0;    // > 1
   // 0: every outer iteration runs the full beta continuation from X0 (the
   // default). > 0: outer iterations after the first warm-start from X at

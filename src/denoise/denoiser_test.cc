@@ -22,8 +22,8 @@ double MeanAngleDeg(const Eigen::MatrixXd& A, const Eigen::MatrixXd& B, const Ei
 }
 
 void NoisyCube(Eigen::MatrixXd* clean, Eigen::MatrixXd* noisy, Eigen::MatrixXi* F) {
-  SubdividedCube(16, clean, F);
-  *noisy = AddNormalNoise(*clean, *F, 0.3 * 2.0 / 16, 7);
+  SubdividedCube(24, clean, F);
+  *noisy = AddNormalNoise(*clean, *F, 0.3 * 2.0 / 24, 7);
 }
 
 TEST(DenoiseOptions, DefaultsAreValid) { EXPECT_TRUE(DenoiseOptions().Check()); }
@@ -164,7 +164,7 @@ TEST(Denoise, LambdaScaleZeroishMovesLittle) {
   DenoiseOptions o;
   o.lambda_scale = 1e-6;
   const DenoiseResult r = Denoise(noisy, F, o);
-  EXPECT_LT((r.V - noisy).cwiseAbs().maxCoeff(), 1e-3 * 2.0 / 16);
+  EXPECT_LT((r.V - noisy).cwiseAbs().maxCoeff(), 1e-3 * 2.0 / 24);
 }
 
 }  // namespace
