@@ -16,6 +16,7 @@
 
 namespace mr {
 
+class OptionManager;
 class Renderer;
 
 struct RefineOptions {
@@ -29,7 +30,7 @@ struct RefineOptions {
   // Upper bound on faces (>= 0; 0: 2x the input's faces, at least 100k).
   int max_faces = 0;
   // Fraction of the Gauss-Newton step taken per iteration, η (0 < step <= 1).
-  double step = 0.5;
+  double step = 1.0;
   // Largest vertex motion per iteration in pixel footprints of the current
   // level (> 0).
   double max_step_px = 1.0;
@@ -84,6 +85,10 @@ struct RefineSummary {
   std::string BriefReport() const;
   std::string FullReport() const;
 };
+
+// Registers every option as --Refine.*, --ViewSelection.*, --Similarity.*,
+// --Denoise.* (shared by mesh_refiner and the benchmarks).
+void RegisterRefineOptions(OptionManager* manager, RefineOptions* options);
 
 // Refines `mesh` in place (positions, connectivity, vertex colours) against
 // the views of `source`. Throws InputError if the mesh is empty, no face is
