@@ -256,6 +256,10 @@ RefineSummary RefineMesh(const ViewSource& source, const RefineOptions& options,
   }
 
   const std::vector<PinholeView> full_views = source.Views();
+  if (!(MedianFootprint(full_views, V, VertexNormals(V, F)) > 0)) {
+    MR_THROW_INPUT << "the mesh is not visible in any view: no vertex faces a camera inside its "
+                      "image (is the mesh in the same coordinate frame as the sparse model?)";
+  }
   const auto neighbors = SelectNeighbors(full_views, V, VertexNormals(V, F), options.view_selection);
   const auto pairs = NeighborPairs(neighbors);
   summary.num_pairs = static_cast<int>(pairs.size());
