@@ -8,6 +8,7 @@
 #include <set>
 #include <sstream>
 
+#include <Eigen/SVD>
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 
@@ -169,6 +170,10 @@ bool SilhouetteOptions::Check() const {
     MR_THROW_INPUT << "SilhouetteOptions::dilate_px = " << dilate_px
                    << ". Violated constraint: dilate_px >= 0";
   }
+  if (fill_holes_px < 0) {
+    MR_THROW_INPUT << "SilhouetteOptions::fill_holes_px = " << fill_holes_px
+                   << ". Violated constraint: fill_holes_px >= 0";
+  }
   if (erode_px < 0) {
     MR_THROW_INPUT << "SilhouetteOptions::erode_px = " << erode_px
                    << ". Violated constraint: erode_px >= 0";
@@ -176,7 +181,8 @@ bool SilhouetteOptions::Check() const {
   return true;
 }
 
-cv::Mat ComputeSilhouette(const cv::Mat& image, const SilhouetteOptions& options) {
+cv::Mat ComputeSilhouette(const cv::Mat& image, const SilhouetteOptions& options,
+                          SilhouetteStats* stats) {
   options.Check();
   MR_CHECK(image.depth() == CV_8U) << "8-bit image expected";
   cv::Mat gray;
@@ -210,7 +216,42 @@ cv::Mat ComputeSilhouette(const cv::Mat& image, const SilhouetteOptions& options
     cv::erode(padded, padded, disc(options.erode_px), cv::Point(-1, -1), 1,
               cv::BORDER_CONSTANT, 0);
   }
-  return padded(cv::Rect(pad, pad, mask.cols, mask.rows)).clone();
+  mask = padded(cv::Rect(pad, pad, mask.cols, mask.rows)).clone();
+  SilhouetteStats local;
+  if (options.fill_holes_px > 0) {
+    // Background is 4-connected where the foreground is 8-connected.
+    cv::Mat labels, comp_stats, centroids;
+    const cv::Mat background = mask == 0;
+    const int n = cv::connectedComponentsWithStats(background, labels, comp_stats, centroids, 4);
+    std::vector<uchar> fill(n, 0);
+    for (int c = 1; c < n; ++c) {
+      const int x = comp_stats.at<int>(c, cv::CC_STAT_LEFT);
+      const int y = comp_stats.at<int>(c, cv::CC_STAT_TOP);
+      const int w = comp_stats.at<int>(c, cv::CC_STAT_WIDTH);
+      const int h = comp_stats.at<int>(c, cv::CC_STAT_HEIGHT);
+      const int area = comp_stats.at<int>(c, cv::CC_STAT_AREA);
+      if (x == 0 || y == 0 || x + w == mask.cols || y + h == mask.rows) continue;  // not a hole
+      if (area <= options.fill_holes_px) {
+        fill[c] = 1;
+        ++local.filled_holes;
+        local.largest_filled = std::max(local.largest_filled, area);
+      } else {
+        ++local.kept_holes;
+        local.smallest_kept = local.smallest_kept == 0 ? area : std::min(local.smallest_kept, area);
+      }
+    }
+    if (local.filled_holes > 0) {
+      for (int r = 0; r < mask.rows; ++r) {
+        const int* l = labels.ptr<int>(r);
+        uchar* m = mask.ptr<uchar>(r);
+        for (int c = 0; c < mask.cols; ++c) {
+          if (fill[l[c]]) m[c] = 255;
+        }
+      }
+    }
+  }
+  if (stats != nullptr) *stats = local;
+  return mask;
 }
 
 void MiddleburyToColmap(const MiddleburyCamera& mb, int width, int height, double scale,
@@ -233,7 +274,10 @@ void MiddleburyToColmap(const MiddleburyCamera& mb, int width, int height, doubl
   image->image_id = id;
   image->camera_id = id;
   image->name = mb.name;
-  image->qvec = RotationToQuaternion(mb.R);
+  // The data sets' rotations are orthonormal to about 1e-7; project onto the
+  // nearest rotation before converting to a quaternion.
+  const Eigen::JacobiSVD<Eigen::Matrix3d> svd(mb.R, Eigen::ComputeFullU | Eigen::ComputeFullV);
+  image->qvec = RotationToQuaternion(svd.matrixU() * svd.matrixV().transpose());
   image->tvec = scale * mb.t;
   image->points2D.clear();
 }
@@ -253,7 +297,8 @@ bool MiddleburyConversionOptions::Check() const {
 
 std::string MiddleburyConversionSummary::BriefReport() const {
   std::ostringstream s;
-  s << num_images << " images (" << holdout.size() << " held out), bbox "
+  s << num_images << " images (" << holdout.size() << " held out), " << filled_holes
+    << " silhouette holes filled, " << kept_holes << " kept, bbox "
     << (has_bbox ? "from README" : "none") << ", " << seconds << " s";
   return s.str();
 }
@@ -364,7 +409,13 @@ MiddleburyConversionSummary ConvertMiddlebury(const std::string& input_path,
     model.images[id] = img;
     WriteBytes(JoinPaths(image_dir, mb.name), bytes);
     std::vector<uchar> png;
-    cv::imencode(".png", ComputeSilhouette(image, options.silhouette), png);
+    SilhouetteStats stats;
+    cv::imencode(".png", ComputeSilhouette(image, options.silhouette, &stats), png);
+    MR_LOG(VERBOSE) << mb.name << ": filled " << stats.filled_holes << " silhouette hole(s) (largest "
+                    << stats.largest_filled << " px), kept " << stats.kept_holes
+                    << " (smallest " << stats.smallest_kept << " px)";
+    summary.filled_holes += stats.filled_holes;
+    summary.kept_holes += stats.kept_holes;
     WriteBytes(JoinPaths(mask_dir, mb.name + ".png"), std::string(png.begin(), png.end()));
     if (holdout_idx.count(static_cast<int>(i + 1))) summary.holdout.push_back(mb.name);
   }
