@@ -90,8 +90,8 @@ std::string VisualHullSummary::BriefReport() const {
   std::ostringstream s;
   s << "grid " << nx << "x" << ny << "x" << nz << " (voxel " << voxel_size << "), "
     << inside_nodes << " inside nodes, " << num_components << " component(s), kept "
-    << num_vertices << " vertices / " << num_faces << " faces, volume " << volume << ", "
-    << seconds << " s";
+    << num_vertices << " vertices / " << num_faces << " faces, volume " << volume << "; "
+    << seconds << " s (carving " << carve_seconds << " s, surface " << extract_seconds << " s)";
   return s.str();
 }
 
@@ -211,7 +211,7 @@ VisualHullSummary ComputeVisualHull(const std::vector<PinholeView>& views,
         box.center() - 0.5 * h * Eigen::Vector3d(nx - 1, ny - 1, nz - 1);
     ScalarGrid grid(nx, ny, nz, origin, h);
     long inside = 0;
-    Progress progress("Carving", nz);
+    const auto carve_start = std::chrono::steady_clock::now();
 #pragma omp parallel for schedule(dynamic) reduction(+ : inside)
     for (int k = 0; k < nz; ++k) {
       for (int j = 0; j < ny; ++j) {
@@ -222,14 +222,16 @@ VisualHullSummary ComputeVisualHull(const std::vector<PinholeView>& views,
         }
       }
     }
-    progress.Done();
+    summary.carve_seconds = Seconds(carve_start);
     if (inside == 0) {
       MR_THROW_INPUT << "visual hull is empty: every node of the " << nx << "x" << ny << "x"
                      << nz << " grid is outside some silhouette (check the masks, the "
                      << "bounding box and the cameras)";
     }
+    const auto extract_start = std::chrono::steady_clock::now();
     ExtractIsosurface(grid, 0.0, V, F);
     summary.num_components = KeepLargestComponent(V, F);
+    summary.extract_seconds = Seconds(extract_start);
     summary.nx = nx;
     summary.ny = ny;
     summary.nz = nz;

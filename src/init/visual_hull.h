@@ -51,7 +51,9 @@ struct VisualHullSummary {
   int num_vertices = 0;
   int num_faces = 0;
   double volume = 0;         // enclosed volume, scene units^3
-  double seconds = 0;
+  double carve_seconds = 0;    // filling the grid (last attempt)
+  double extract_seconds = 0;  // marching tetrahedra + components (last attempt)
+  double seconds = 0;          // total, including distance transforms
   std::string BriefReport() const;
 };
 
