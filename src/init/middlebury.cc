@@ -206,17 +206,12 @@ cv::Mat ComputeSilhouette(const cv::Mat& image, const SilhouetteOptions& options
   auto disc = [](int radius) {
     return cv::getStructuringElement(cv::MORPH_ELLIPSE, cv::Size(2 * radius + 1, 2 * radius + 1));
   };
-  // Pixels outside the image count as background for the erosion, and do not
-  // grow the dilation (pad with 0).
-  const int pad = options.dilate_px + options.erode_px + 1;
-  cv::Mat padded;
-  cv::copyMakeBorder(mask, padded, pad, pad, pad, pad, cv::BORDER_CONSTANT, 0);
-  if (options.dilate_px > 0) cv::dilate(padded, padded, disc(options.dilate_px));
-  if (options.erode_px > 0) {
-    cv::erode(padded, padded, disc(options.erode_px), cv::Point(-1, -1), 1,
-              cv::BORDER_CONSTANT, 0);
-  }
-  mask = padded(cv::Rect(pad, pad, mask.cols, mask.rows)).clone();
+  // Matlab's imdilate/imerode semantics at the image border: outside pixels
+  // neither dilate nor erode (OpenCV's default border values, -inf for
+  // dilation and +inf for erosion). An object cut by the image border thus
+  // stays foreground up to the border.
+  if (options.dilate_px > 0) cv::dilate(mask, mask, disc(options.dilate_px));
+  if (options.erode_px > 0) cv::erode(mask, mask, disc(options.erode_px));
   SilhouetteStats local;
   if (options.fill_holes_px > 0) {
     // Background is 4-connected where the foreground is 8-connected.

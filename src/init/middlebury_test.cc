@@ -200,6 +200,14 @@ TEST(ComputeSilhouette, FillsShadowsAndGrowsByThreePixels) {
   SilhouetteOptions no_fill;
   no_fill.fill_holes_px = 0;
   EXPECT_EQ(ComputeSilhouette(holes, no_fill).at<uchar>(53, 53), 0);
+  // An object cut by the image border is not eroded from the border.
+  cv::Mat cut(50, 50, CV_8UC1, cv::Scalar(0));
+  cut(cv::Rect(0, 10, 20, 30)).setTo(200);
+  const cv::Mat cut_mask = ComputeSilhouette(cut, SilhouetteOptions());
+  EXPECT_EQ(cut_mask.at<uchar>(25, 0), 255);
+  EXPECT_EQ(cut_mask.at<uchar>(10, 0), 255);
+  EXPECT_EQ(cut_mask.at<uchar>(25, 22), 255);  // +3 px on the inner side
+  EXPECT_EQ(cut_mask.at<uchar>(25, 24), 0);
   // Just below and above the threshold (0.19 * 255 = 48.45).
   cv::Mat flat(20, 20, CV_8UC1, cv::Scalar(48));
   EXPECT_EQ(cv::countNonZero(ComputeSilhouette(flat, SilhouetteOptions())), 0);
