@@ -16,6 +16,9 @@
 namespace mr {
 namespace {
 
+// Largest grid carved (4 bytes per node: 2 GiB).
+constexpr double kMaxNodes = 512.0 * 1024 * 1024;
+
 double Seconds(std::chrono::steady_clock::time_point start) {
   return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
 }
@@ -207,6 +210,12 @@ VisualHullSummary ComputeVisualHull(const std::vector<PinholeView>& views,
     const int nx = static_cast<int>(std::ceil(box.sizes().x() / h)) + 3;
     const int ny = static_cast<int>(std::ceil(box.sizes().y() / h)) + 3;
     const int nz = static_cast<int>(std::ceil(box.sizes().z() / h)) + 3;
+    const double num_nodes = static_cast<double>(nx) * ny * nz;
+    if (num_nodes > kMaxNodes) {
+      MR_THROW_INPUT << "visual hull: a " << nx << "x" << ny << "x" << nz << " grid ("
+                     << num_nodes * 4 / (1 << 30) << " GiB) exceeds the limit of " << kMaxNodes
+                     << " nodes; lower the resolution (now " << resolution << ")";
+    }
     const Eigen::Vector3d origin =
         box.center() - 0.5 * h * Eigen::Vector3d(nx - 1, ny - 1, nz - 1);
     ScalarGrid grid(nx, ny, nz, origin, h);

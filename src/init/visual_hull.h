@@ -28,7 +28,8 @@ namespace mr {
 
 struct VisualHullOptions {
   // Grid cells along the longest side of the (padded) bounding box, in
-  // [4, 2048]. The cost is O(resolution^3 * views).
+  // [4, 2048]. The cost is O(resolution^3 * views); grids of more than 2^29
+  // nodes (2 GiB) are refused.
   int resolution = 128;
   // Padding added to every side of the bounding box, as a fraction of its
   // longest side (>= 0). Middlebury's boxes are tight, and the silhouettes

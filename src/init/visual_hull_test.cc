@@ -185,6 +185,18 @@ TEST(VisualHull, TargetFacesAdjustsResolution) {
   EXPECT_TRUE(IsClosedAndOriented(F));
 }
 
+TEST(VisualHull, HugeGridIsRefused) {
+  std::vector<PinholeView> views;
+  std::vector<cv::Mat> masks;
+  SphereScene(&views, &masks);
+  const Eigen::AlignedBox3d bbox(Eigen::Vector3d::Constant(-1.5), Eigen::Vector3d::Constant(1.5));
+  Eigen::MatrixXd V;
+  Eigen::MatrixXi F;
+  VisualHullOptions options;
+  options.resolution = 2048;  // 2051^3 nodes
+  EXPECT_THROW(ComputeVisualHull(views, masks, bbox, options, &V, &F), InputError);
+}
+
 TEST(VisualHull, EmptyMasksThrow) {
   std::vector<PinholeView> views;
   std::vector<cv::Mat> masks;
