@@ -10,7 +10,11 @@
 #include "colmap_io/workspace.h"
 #include "geometry/view.h"
 #include "init/middlebury.h"
+#include "init/isosurface.h"
 #include "init/visual_hull.h"
+#ifdef MR_HAVE_REMESH
+#include "geometry/remesh.h"
+#endif
 #include "util/error.h"
 #include "util/file.h"
 #include "util/logging.h"
@@ -30,8 +34,13 @@ int main(int argc, char** argv) {
                 "output PLY (default: <workspace>/meshed-visualhull.ply)");
     manager.Add("resolution", &options.resolution,
                 "grid cells along the longest side of the box, [4, 2048]");
-    manager.Add("target_faces", &options.target_faces,
-                "if > 0, adjust the resolution for about this many faces");
+    int target_faces = 0;
+    double remesh_edge_length = 0;
+    manager.Add("target_faces", &target_faces,
+                "if > 0, decimate the hull to at most this many faces (Garland-Heckbert)");
+    manager.Add("remesh_edge_length", &remesh_edge_length,
+                "if > 0, isotropic remeshing to this edge length (scene units), after "
+                "decimation");
     manager.Add("bbox", &bbox_text,
                 "\"x0 y0 z0 x1 y1 z1\" (default: <workspace>/bbox.txt, else the cameras' "
                 "common field of view)");
@@ -45,6 +54,16 @@ int main(int argc, char** argv) {
                 "use only the images listed in <workspace>/silhouette_images.txt, if present");
     if (!manager.Parse(argc, argv)) return 0;
     options.Check();
+    if (target_faces < 0) MR_THROW_INPUT << "--target_faces " << target_faces << ", expected >= 0";
+    if (!(remesh_edge_length >= 0)) {
+      MR_THROW_INPUT << "--remesh_edge_length " << remesh_edge_length << ", expected >= 0";
+    }
+#ifndef MR_HAVE_REMESH
+    if (target_faces > 0 || remesh_edge_length > 0) {
+      MR_THROW_INPUT << "--target_faces/--remesh_edge_length need mr_remesh (CGAL), which this "
+                        "build lacks";
+    }
+#endif
     if (output_path.empty()) output_path = mr::JoinPaths(workspace_path, "meshed-visualhull.ply");
 
     const mr::Workspace ws = mr::OpenWorkspace(workspace_path);
@@ -107,6 +126,21 @@ int main(int argc, char** argv) {
     if (summary.num_components > 1) {
       MR_LOG(INFO) << "Kept the largest of " << summary.num_components << " components";
     }
+#ifdef MR_HAVE_REMESH
+    if (target_faces > 0 && mesh.NumFaces() > target_faces) {
+      mr::Decimate(&mesh.V, &mesh.F, target_faces);  // logs its own summary
+    }
+    if (remesh_edge_length > 0) {
+      mr::IsotropicRemesh(&mesh.V, &mesh.F, remesh_edge_length);  // logs its own summary
+    }
+    if (target_faces > 0 || remesh_edge_length > 0) {
+      std::string why;
+      if (!mr::IsClosedAndOriented(mesh.F, &why) || mr::SignedVolume(mesh.V, mesh.F) <= 0) {
+        MR_THROW_INPUT << "the decimated/remeshed hull is no longer closed and outward ("
+                       << why << "); run without --target_faces/--remesh_edge_length";
+      }
+    }
+#endif
     mr::WritePly(output_path, mesh);
     MR_LOG(INFO) << "Wrote " << output_path << " (" << mesh.NumVertices() << " vertices, "
                  << mesh.NumFaces() << " faces)";

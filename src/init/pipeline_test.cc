@@ -100,6 +100,26 @@ TEST(MiddleburyPipeline, SphereHullInMillimetres) {
     ASSERT_GT(r, 20 - voxel) << "vertex " << v;
     ASSERT_LT(r, 1.3 * 20 + voxel) << "vertex " << v;
   }
+  // Decimated and remeshed hulls stay closed and outward (if this build has
+  // mr_remesh; otherwise the flags are refused with an ERROR line).
+  const std::string small = JoinPaths(ws, "hull_small.ply");
+  const std::string cmd2 = exe + " --workspace_path " + ws + " --output_path " + small +
+                           " --resolution 40 --VisualHull.min_views 2 --target_faces 2000"
+                           " --remesh_edge_length 4 2> " + log;
+  if (std::system(cmd2.c_str()) == 0) {
+    const TriangleMesh dec = ReadPly(small);
+    EXPECT_GT(dec.NumFaces(), 200);
+    EXPECT_LT(dec.NumFaces(), mesh.NumFaces());
+    EXPECT_TRUE(IsClosedAndOriented(dec.F, &why)) << why;
+    EXPECT_GT(SignedVolume(dec.V, dec.F), 0);
+    for (int v = 0; v < dec.NumVertices(); ++v) {
+      ASSERT_GT(dec.V.row(v).norm(), 20 - 2 * voxel) << "vertex " << v;
+      ASSERT_LT(dec.V.row(v).norm(), 1.3 * 20 + 2 * voxel) << "vertex " << v;
+    }
+  } else {
+    EXPECT_NE(ReadFileToString(log).find("mr_remesh"), std::string::npos)
+        << ReadFileToString(log);
+  }
   // A missing workspace fails with one ERROR line.
   const std::string bad = exe + " --workspace_path " + JoinPaths(ws, "nope") + " 2> " + log;
   EXPECT_NE(std::system(bad.c_str()), 0);
