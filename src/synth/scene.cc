@@ -98,9 +98,11 @@ std::vector<PinholeView> MakeCameras(const CameraRigOptions& options, double bou
 }
 
 PinholeView DenseConventionView(const PinholeView& view) {
+  // A point at image point x of `view` is at x + 0.5 in the returned view,
+  // whose pixel col is sampled at col + 0.5, i.e. at image point col of `view`.
   PinholeView v = view;
-  v.cx -= 0.5;
-  v.cy -= 0.5;
+  v.cx += 0.5;
+  v.cy += 0.5;
   return v;
 }
 
