@@ -5,6 +5,8 @@
 #include <random>
 
 #include <Eigen/Geometry>
+#include <opencv2/core.hpp>
+#include <opencv2/imgproc.hpp>
 
 #include "util/error.h"
 
@@ -162,6 +164,18 @@ bool DepthNoiseOptions::Check() const {
     MR_THROW_INPUT << "DepthNoiseOptions::depth_noise = " << depth_noise
                    << ". Violated constraint: 0 <= depth_noise <= 0.1";
   }
+  if (!(correlated_noise >= 0 && correlated_noise <= 0.1)) {
+    MR_THROW_INPUT << "DepthNoiseOptions::correlated_noise = " << correlated_noise
+                   << ". Violated constraint: 0 <= correlated_noise <= 0.1";
+  }
+  if (!(correlation_px >= 0.5 && correlation_px <= 100)) {
+    MR_THROW_INPUT << "DepthNoiseOptions::correlation_px = " << correlation_px
+                   << ". Violated constraint: 0.5 <= correlation_px <= 100";
+  }
+  if (!(depth_blur_px >= 0 && depth_blur_px <= 20)) {
+    MR_THROW_INPUT << "DepthNoiseOptions::depth_blur_px = " << depth_blur_px
+                   << ". Violated constraint: 0 <= depth_blur_px <= 20";
+  }
   if (!(outlier_fraction >= 0 && outlier_fraction <= 0.5)) {
     MR_THROW_INPUT << "DepthNoiseOptions::outlier_fraction = " << outlier_fraction
                    << ". Violated constraint: 0 <= outlier_fraction <= 0.5";
@@ -193,6 +207,36 @@ DenseMaps RenderDenseMaps(Renderer& renderer, const SynthScene& scene, const Pin
   std::mt19937 rng(seed);
   std::normal_distribution<double> gauss(0.0, 1.0);
   std::uniform_real_distribution<double> uniform(0.0, 1.0);
+
+  // Smoothed true depth (normalised convolution over the object's pixels).
+  cv::Mat valid(H, W, CV_32F, cv::Scalar(0)), depth(H, W, CV_32F, cv::Scalar(0));
+  for (int row = 0; row < H; ++row) {
+    for (int col = 0; col < W; ++col) {
+      const size_t idx = static_cast<size_t>(row) * W + col;
+      if (maps.exact.face_id[idx] < 0) continue;
+      valid.at<float>(row, col) = 1;
+      depth.at<float>(row, col) = maps.exact.depth[idx];
+    }
+  }
+  cv::Mat smooth = depth;
+  if (options.depth_blur_px > 0) {
+    cv::Mat num, den;
+    cv::GaussianBlur(depth, num, cv::Size(0, 0), options.depth_blur_px);
+    cv::GaussianBlur(valid, den, cv::Size(0, 0), options.depth_blur_px);
+    smooth = num / cv::max(den, 1e-6);
+  }
+  // A smooth random field with unit standard deviation.
+  cv::Mat field(H, W, CV_32F, cv::Scalar(0));
+  if (options.correlated_noise > 0) {
+    for (int row = 0; row < H; ++row) {
+      for (int col = 0; col < W; ++col) field.at<float>(row, col) = static_cast<float>(gauss(rng));
+    }
+    cv::GaussianBlur(field, field, cv::Size(0, 0), options.correlation_px);
+    cv::Scalar mean, stddev;
+    cv::meanStdDev(field, mean, stddev);
+    if (stddev[0] > 0) field = (field - mean[0]) / stddev[0];
+  }
+
   for (int row = 0; row < H; ++row) {
     for (int col = 0; col < W; ++col) {
       const size_t idx = static_cast<size_t>(row) * W + col;
@@ -212,7 +256,9 @@ DenseMaps RenderDenseMaps(Renderer& renderer, const SynthScene& scene, const Pin
       const double u_out = uniform(rng), u_scale = uniform(rng);
       const Eigen::Vector3d gn(gauss(rng), gauss(rng), gauss(rng));
       if (cos_incidence < options.min_cos_incidence) continue;
-      double noisy = d * (1 + options.depth_noise * g);
+      const double base = smooth.at<float>(row, col);
+      double noisy = base * (1 + options.depth_noise * g +
+                             options.correlated_noise * field.at<float>(row, col));
       if (u_out < options.outlier_fraction) noisy = d * (0.85 + 0.3 * u_scale);
       if (!(noisy > 0)) continue;
       Eigen::Vector3d nn = (n + options.normal_noise * gn).normalized();

@@ -30,8 +30,9 @@ struct CameraRigOptions {
   double elevation_deg = 30;       // ring elevation above the xy plane, [-89, 89]
   double min_elevation_deg = 10;   // hemisphere band, [-89, max_elevation_deg)
   double max_elevation_deg = 75;   // hemisphere band, (min_elevation_deg, 89]
-  // Fraction of the image height covered by the object's bounding sphere. (0, 1].
-  double fill_fraction = 0.7;
+  // Fraction of the image height covered by the object's bounding sphere
+  // (about the bounding-box centre; the object itself then fills ~70%). (0, 1].
+  double fill_fraction = 0.8;
   // Focal length in pixels as a multiple of the image width (0.9 ~ 58 deg
   // horizontal field of view). Range (0.1, 10].
   double focal_factor = 0.9;
@@ -79,6 +80,15 @@ struct DepthNoiseOptions {
   // Standard deviation of the per-pixel Gaussian depth noise, relative to
   // the depth. Range [0, 0.1].
   double depth_noise = 0.002;
+  // Standard deviation of a spatially correlated depth error (relative to
+  // the depth), independent per view: PatchMatch's errors come in patches,
+  // which fusion does not average away within a view. Range [0, 0.1].
+  double correlated_noise = 0.003;
+  // Correlation length (pixels, Gaussian sigma) of that error. Range [0.5, 100].
+  double correlation_px = 6;
+  // Gaussian smoothing (pixels, sigma) of the true depth inside the object
+  // before the noise, like PatchMatch's window; 0 = none. Range [0, 20].
+  double depth_blur_px = 2;
   // Fraction of valid pixels replaced by outliers (depth scaled by a uniform
   // factor in [0.85, 1.15]). Range [0, 0.5].
   double outlier_fraction = 0.002;
