@@ -43,6 +43,12 @@ int main(int argc, char** argv) {
     options.Add("seed", &o.seed, "random seed");
     options.Add("depth_noise", &o.noise.depth_noise,
                 "per-pixel Gaussian depth noise (standard deviation relative to depth)");
+    options.Add("correlated_noise", &o.noise.correlated_noise,
+                "spatially correlated depth error (standard deviation relative to depth)");
+    options.Add("correlation_px", &o.noise.correlation_px,
+                "correlation length of that error (pixels)");
+    options.Add("depth_blur_px", &o.noise.depth_blur_px,
+                "smoothing of the true depth before the noise (pixels, PatchMatch-like)");
     options.Add("outlier_fraction", &o.noise.outlier_fraction,
                 "fraction of depth pixels that are outliers");
     options.Add("normal_noise", &o.noise.normal_noise, "normal noise (radians, approx.)");

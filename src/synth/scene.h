@@ -79,16 +79,16 @@ SynthImage RenderImage(Renderer& renderer, const SynthScene& scene, const Pinhol
 struct DepthNoiseOptions {
   // Standard deviation of the per-pixel Gaussian depth noise, relative to
   // the depth. Range [0, 0.1].
-  double depth_noise = 0.002;
+  double depth_noise = 0.0025;
   // Standard deviation of a spatially correlated depth error (relative to
   // the depth), independent per view: PatchMatch's errors come in patches,
   // which fusion does not average away within a view. Range [0, 0.1].
-  double correlated_noise = 0.003;
+  double correlated_noise = 0.004;
   // Correlation length (pixels, Gaussian sigma) of that error. Range [0.5, 100].
   double correlation_px = 6;
   // Gaussian smoothing (pixels, sigma) of the true depth inside the object
   // before the noise, like PatchMatch's window; 0 = none. Range [0, 20].
-  double depth_blur_px = 2;
+  double depth_blur_px = 3;
   // Fraction of valid pixels replaced by outliers (depth scaled by a uniform
   // factor in [0.85, 1.15]). Range [0, 0.5].
   double outlier_fraction = 0.002;
