@@ -35,7 +35,8 @@ TriangleMesh ReadPly(const std::string& path);
 
 // Writes `mesh` atomically (temporary file in the same folder, then rename).
 // N, C and values are written when non-empty. Faces are written as
-// `list uchar int vertex_indices`, like COLMAP.
+// `list uchar int vertex_indices`, like COLMAP; positions, normals and values
+// as float (again like COLMAP), so a round trip rounds them to float.
 void WritePly(const std::string& path, const TriangleMesh& mesh,
               PlyFormat format = PlyFormat::kBinaryLittleEndian);
 

@@ -60,14 +60,21 @@ struct Reconstruction {
 };
 
 // Reads a model folder holding cameras/images/points3D as .bin (preferred if
-// both exist) or .txt. Throws InputError naming the file and the bad field
-// (unknown camera model id, truncated file, image referring to a missing
-// camera, ...).
+// both exist) or .txt. Throws InputError naming the file (and line, for
+// text) and the bad field: truncated file or trailing bytes, a count larger
+// than the rest of the file can hold, unknown camera model id (11+) or name,
+// wrong parameter count, width/height outside 1..2^20, non-positive focal
+// length, NaN/Inf anywhere, zero quaternion, empty image name, duplicate
+// ids, an image referring to a missing camera, a track referring to a
+// missing image or to a point2D index out of range. A point2D's point3D_id
+// is only checked to be >= -1 (it may name a point absent from points3D).
+// Quaternions are returned as stored (not re-normalized).
 Reconstruction ReadSparseModel(const std::string& dir);
 Reconstruction ReadSparseModelBinary(const std::string& dir);
 Reconstruction ReadSparseModelText(const std::string& dir);
 
-// Write the three files atomically into an existing folder.
+// Write the three files atomically into an existing folder. Text files use
+// max_digits10 digits, so text round trips are exact.
 void WriteSparseModelBinary(const std::string& dir, const Reconstruction& model);
 void WriteSparseModelText(const std::string& dir, const Reconstruction& model);
 

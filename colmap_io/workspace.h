@@ -8,7 +8,11 @@
 // meshed-delaunay.ply. A sparse workspace (a project folder with images/ and
 // sparse/0 in a distorted model) is undistorted first, into
 // <workspace>/mesh_refiner_undistorted/, which is then opened as a dense
-// workspace; the log says how.
+// workspace; the log and Workspace::undistortion say how. A complete earlier
+// undistortion of the same model and folders is reused; a folder of that name
+// not written by mesh_refiner is never overwritten (InputError).
+// The sparse model is looked for in <workspace>/sparse, then in the
+// lowest-numbered <workspace>/sparse/<n>.
 
 #include <string>
 #include <vector>
@@ -20,8 +24,10 @@
 namespace mr {
 
 struct WorkspaceOptions {
-  // Folder of masks named "<image name>.png" (COLMAP's convention); empty:
-  // use <workspace>/masks if it exists, else no masks.
+  // Folder of masks named "<image name>.png" (COLMAP's convention:
+  // images/a.jpg -> masks/a.jpg.png); must exist if set. Empty: use
+  // <workspace>/masks, else <workspace>/stereo/masks, if it exists, else no
+  // masks. Masks of a distorted sparse project are undistorted with it.
   std::string mask_path;
   // Folder of the images; empty: <workspace>/images.
   std::string image_path;
@@ -41,7 +47,8 @@ struct Workspace {
   std::string ImagePath(uint32_t image_id) const;
   // Path of the mask of an image, or "" if there is none.
   std::string MaskPath(uint32_t image_id) const;
-  // meshed-poisson.ply if present, else meshed-delaunay.ply, else "".
+  // meshed-poisson.ply if present, else meshed-delaunay.ply, else "";
+  // looked for in `root`, then (after undistortion) in the project folder.
   std::string DefaultMeshPath() const;
   // Reads an image (8-bit; grayscale or BGR). Throws InputError if missing or
   // if its size differs from its camera's.

@@ -1,5 +1,7 @@
 #include <gtest/gtest.h>
 
+#include <Eigen/LU>
+
 #include "geometry/mesh.h"
 #include "geometry/view.h"
 
@@ -57,6 +59,17 @@ TEST(Mesh, RemoveUnreferencedVertices) {
   EXPECT_EQ(V.row(F(0, 0)), V0.row(4));
 }
 
+TEST(PinholeView, LookAt) {
+  const PinholeView v = LookAtView(Eigen::Vector3d(0, -5, 0), Eigen::Vector3d::Zero(),
+                                   Eigen::Vector3d(0, 0, 1), 64, 48, 50);
+  EXPECT_NEAR(v.R.determinant(), 1.0, 1e-12);
+  EXPECT_TRUE((v.Center() - Eigen::Vector3d(0, -5, 0)).norm() < 1e-12);
+  EXPECT_TRUE((v.Project(Eigen::Vector3d::Zero()) - Eigen::Vector2d(32, 24)).norm() < 1e-12);
+  // World up appears at smaller image y; world +x appears to the right.
+  EXPECT_LT(v.Project(Eigen::Vector3d(0, 0, 1)).y(), 24);
+  EXPECT_GT(v.Project(Eigen::Vector3d(1, 0, 0)).x(), 32);
+}
+
 TEST(PinholeView, ProjectAndScale) {
   PinholeView v;
   v.width = 640;
@@ -73,6 +86,30 @@ TEST(PinholeView, ProjectAndScale) {
   const PinholeView h = v.Scaled(0.5);
   EXPECT_EQ(h.width, 320);
   EXPECT_TRUE((h.Project(X) - 0.5 * p).norm() < 1e-12);
+}
+
+}  // namespace
+}  // namespace mr
+
+#include "geometry/primitives.h"
+
+namespace mr {
+namespace {
+
+TEST(Primitives, IcosphereIsClosedAndOutward) {
+  Eigen::MatrixXd V;
+  Eigen::MatrixXi F;
+  MakeIcosphere(2, 2.0, &V, &F);
+  EXPECT_EQ(F.rows(), 320);
+  const EdgeTopology topo = ComputeEdgeTopology(F, static_cast<int>(V.rows()));
+  EXPECT_EQ(topo.NumBoundaryEdges(), 0);
+  EXPECT_EQ(topo.NumNonManifoldEdges(), 0);
+  const Eigen::MatrixXd N = FaceNormals(V, F);
+  for (int f = 0; f < F.rows(); ++f) {
+    const Eigen::Vector3d c = (V.row(F(f, 0)) + V.row(F(f, 1)) + V.row(F(f, 2))) / 3.0;
+    EXPECT_GT(N.row(f).dot(c), 0) << "face " << f << " points inward";
+  }
+  EXPECT_NEAR(V.rowwise().norm().maxCoeff(), 2.0, 1e-12);
 }
 
 }  // namespace

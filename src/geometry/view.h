@@ -33,9 +33,15 @@ struct PinholeView {
     return p.x() >= 0 && p.y() >= 0 && p.x() < width && p.y() < height;
   }
   // The same view at `scale` times the resolution (a pyramid level is
-  // Scaled(0.5)); continuous image coordinates scale exactly.
+  // Scaled(0.5)); continuous image coordinates scale exactly, the pixel
+  // count rounds up.
   PinholeView Scaled(double scale) const;
 };
+
+// A view at `center` looking at `target`, with the image's up direction
+// closest to `up` (world); principal point at the image centre.
+PinholeView LookAtView(const Eigen::Vector3d& center, const Eigen::Vector3d& target,
+                       const Eigen::Vector3d& up, int width, int height, double focal);
 
 // The pinhole view of a registered image. Throws InputError if the camera is
 // not PINHOLE or SIMPLE_PINHOLE (undistort first).

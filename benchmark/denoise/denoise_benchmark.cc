@@ -1,0 +1,240 @@
+// Denoising benchmark (not a test): quality on the standard protocol and speed.
+//
+//   denoise_benchmark quality [MODELS_DIR]   markdown table on stdout
+//   denoise_benchmark speed NUM_FACES        time + peak memory of lp on a noisy cube
+//   denoise_benchmark one MODEL [METHOD]     one model, one method, per-iteration log
+//
+// Protocol: Gaussian noise along the vertex normals with sigma = 0.3 x mean
+// edge length (seed 1) added to a clean mesh. E_a: mean angle (degrees)
+// between corresponding face normals of the result and the clean mesh. E_v:
+// mean distance from the result's vertices to the clean surface (exact, AABB
+// tree) divided by the clean mesh's bounding-box diagonal.
+
+#include <cmath>
+#include <cstdio>
+#include <fstream>
+#include <iostream>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include <CGAL/AABB_traits.h>
+#include <CGAL/AABB_tree.h>
+#include <CGAL/AABB_triangle_primitive.h>
+#include <CGAL/Simple_cartesian.h>
+
+#include "denoise/denoiser.h"
+#include "denoise/synthetic_meshes.h"
+#include "geometry/mesh.h"
+#include "util/error.h"
+#include "util/logging.h"
+
+namespace {
+
+using K = CGAL::Simple_cartesian<double>;
+using Triangle = K::Triangle_3;
+using Iterator = std::vector<Triangle>::const_iterator;
+using Primitive = CGAL::AABB_triangle_primitive<K, Iterator>;
+using Tree = CGAL::AABB_tree<CGAL::AABB_traits<K, Primitive>>;
+
+// Minimal OBJ reader (v and f lines; polygons fan-triangulated).
+void ReadObj(const std::string& path, Eigen::MatrixXd* V, Eigen::MatrixXi* F) {
+  std::ifstream in(path);
+  if (!in) MR_THROW_INPUT << path << ": cannot open";
+  std::vector<Eigen::Vector3d> verts;
+  std::vector<Eigen::Vector3i> faces;
+  std::string line;
+  while (std::getline(in, line)) {
+    std::istringstream s(line);
+    std::string tag;
+    s >> tag;
+    if (tag == "v") {
+      Eigen::Vector3d p;
+      s >> p.x() >> p.y() >> p.z();
+      verts.push_back(p);
+    } else if (tag == "f") {
+      std::vector<int> idx;
+      std::string tok;
+      while (s >> tok) idx.push_back(std::stoi(tok.substr(0, tok.find('/'))) - 1);
+      for (size_t k = 2; k < idx.size(); ++k) faces.emplace_back(idx[0], idx[k - 1], idx[k]);
+    }
+  }
+  V->resize(static_cast<int>(verts.size()), 3);
+  for (size_t i = 0; i < verts.size(); ++i) V->row(i) = verts[i].transpose();
+  F->resize(static_cast<int>(faces.size()), 3);
+  for (size_t i = 0; i < faces.size(); ++i) F->row(i) = faces[i].transpose();
+}
+
+struct Errors {
+  double ea = 0, ev = 0;
+};
+
+class Metric {
+ public:
+  Metric(const Eigen::MatrixXd& V, const Eigen::MatrixXi& F) : N_(mr::FaceNormals(V, F)) {
+    for (int f = 0; f < F.rows(); ++f) {
+      auto p = [&](int k) { return K::Point_3(V(F(f, k), 0), V(F(f, k), 1), V(F(f, k), 2)); };
+      tris_.emplace_back(p(0), p(1), p(2));
+    }
+    tree_.insert(tris_.begin(), tris_.end());
+    tree_.accelerate_distance_queries();
+    diag_ = mr::BoundingBoxDiagonal(V);
+  }
+  Errors Evaluate(const Eigen::MatrixXd& X, const Eigen::MatrixXi& F) const {
+    Errors e;
+    const Eigen::MatrixXd N = mr::FaceNormals(X, F);
+    for (int f = 0; f < F.rows(); ++f) {
+      const double c = std::max(-1.0, std::min(1.0, N.row(f).dot(N_.row(f))));
+      e.ea += std::acos(c) * 180.0 / M_PI;
+    }
+    e.ea /= F.rows();
+    for (int v = 0; v < X.rows(); ++v) {
+      e.ev += std::sqrt(tree_.squared_distance(K::Point_3(X(v, 0), X(v, 1), X(v, 2))));
+    }
+    e.ev /= X.rows() * diag_;
+    return e;
+  }
+
+ private:
+  Eigen::MatrixXd N_;
+  std::vector<Triangle> tris_;
+  Tree tree_;
+  double diag_ = 1;
+};
+
+// Experiment-only overrides of the lp options from the environment (MAXIT,
+// FIXP, LSCALE, BMAX, B0, FIXL, BF, UPDOP); unset = defaults. Results in docs/ use none.
+void ApplyEnvOverrides(mr::DenoiseOptions* o) {
+  auto env = [](const char* name, double fallback) {
+    const char* v = std::getenv(name);
+    return v != nullptr ? std::atof(v) : fallback;
+  };
+  o->max_iterations = static_cast<int>(env("MAXIT", o->max_iterations));
+  o->fixed_p = env("FIXP", o->fixed_p);
+  o->lambda_scale = env("LSCALE", o->lambda_scale);
+  o->beta_max = env("BMAX", o->beta_max);
+  o->beta_initial = env("B0", o->beta_initial);
+  o->fixed_lambda = env("FIXL", o->fixed_lambda);
+  o->beta_factor = env("BF", o->beta_factor);
+  o->update_operator = env("UPDOP", o->update_operator ? 1 : 0) != 0;
+}
+
+double PeakMemoryMiB() {
+  std::ifstream in("/proc/self/status");
+  std::string line;
+  while (std::getline(in, line)) {
+    if (line.rfind("VmHWM:", 0) == 0) return std::stod(line.substr(6)) / 1024.0;
+  }
+  return 0;
+}
+
+int Quality(const std::string& models_dir, const std::string& only, const std::string& method) {
+  struct Model {
+    std::string name;
+    Eigen::MatrixXd V;
+    Eigen::MatrixXi F;
+  };
+  std::vector<Model> models;
+  for (const char* name : {"fandisk", "rocker-arm", "stanford-bunny"}) {
+    Model m{name, {}, {}};
+    ReadObj(models_dir + "/" + name + ".obj", &m.V, &m.F);
+    models.push_back(m);
+  }
+  {
+    Model m{"cube-40", {}, {}};
+    mr::SubdividedCube(40, &m.V, &m.F);
+    models.push_back(m);
+    Model o{"octahedron-5", {}, {}};
+    mr::SubdividedOctahedron(5, &o.V, &o.F);
+    models.push_back(o);
+  }
+  std::printf(
+      "| model | faces | noisy E_a | noisy E_v | lp E_a | lp E_v | lp s | laplacian(10) E_a | "
+      "laplacian best E_a (iters) | laplacian best E_v (iters) | bilateral E_a | bilateral E_v "
+      "| lp p/theta/sigma/lambda (last) |\n");
+  std::printf("|---|---|---|---|---|---|---|---|---|---|---|---|---|\n");
+  for (const Model& m : models) {
+    if (!only.empty() && m.name != only) continue;
+    const Metric metric(m.V, m.F);
+    if (!only.empty()) {
+      // One model, one method, verbose: for studying the behaviour.
+      const double h = mr::MeanEdgeLength(m.V, m.F);
+      const Eigen::MatrixXd noisy = mr::AddNormalNoise(m.V, m.F, 0.3 * h, 1);
+      mr::DenoiseOptions o;
+      o.method = method;
+      o.verbose = true;
+      ApplyEnvOverrides(&o);
+      const Errors en = metric.Evaluate(noisy, m.F);
+      const Errors e = metric.Evaluate(mr::Denoise(noisy, m.F, o).V, m.F);
+      std::printf("%s %s: noisy E_a %.2f E_v %.2e -> E_a %.2f E_v %.2e\n", m.name.c_str(),
+                  method.c_str(), en.ea, en.ev, e.ea, e.ev);
+      continue;
+    }
+    const double h = mr::MeanEdgeLength(m.V, m.F);
+    const Eigen::MatrixXd noisy = mr::AddNormalNoise(m.V, m.F, 0.3 * h, 1);
+    const Errors en = metric.Evaluate(noisy, m.F);
+    mr::DenoiseOptions lp;
+    ApplyEnvOverrides(&lp);
+    const mr::DenoiseResult rlp = mr::Denoise(noisy, m.F, lp);
+    const Errors elp = metric.Evaluate(rlp.V, m.F);
+    mr::DenoiseOptions lap;
+    lap.method = "laplacian";
+    const Errors elap10 = metric.Evaluate(mr::Denoise(noisy, m.F, lap).V, m.F);
+    Errors best_a{1e9, 1e9}, best_v{1e9, 1e9};
+    int best_a_it = 0, best_v_it = 0;
+    for (int iters : {1, 2, 3, 4, 6, 8, 10, 15, 20, 30, 50, 80}) {
+      lap.laplacian_iterations = iters;
+      const Errors e = metric.Evaluate(mr::Denoise(noisy, m.F, lap).V, m.F);
+      if (e.ea < best_a.ea) best_a = e, best_a_it = iters;
+      if (e.ev < best_v.ev) best_v = e, best_v_it = iters;
+    }
+    mr::DenoiseOptions bil;
+    bil.method = "bilateral_normal";
+    const Errors ebil = metric.Evaluate(mr::Denoise(noisy, m.F, bil).V, m.F);
+    const mr::DenoiseIteration& last = rlp.iterations.back();
+    std::printf(
+        "| %s | %d | %.2f | %.2e | **%.2f** | %.2e | %.2f | %.2f | %.2f (%d) | %.2e (%d) | %.2f | "
+        "%.2e | %.2f / %.3g / %.3g / %.3g (%zu it) |\n",
+        m.name.c_str(), static_cast<int>(m.F.rows()), en.ea, en.ev, elp.ea, elp.ev,
+        rlp.total_seconds, elap10.ea, best_a.ea, best_a_it, best_v.ev, best_v_it, ebil.ea, ebil.ev,
+        last.p, last.theta, last.sigma, last.lambda, rlp.iterations.size());
+    std::fflush(stdout);
+  }
+  return 0;
+}
+
+int Speed(long faces) {
+  const int n = static_cast<int>(std::lround(std::sqrt(faces / 12.0)));
+  Eigen::MatrixXd V;
+  Eigen::MatrixXi F;
+  mr::SubdividedCube(n, &V, &F);
+  const Eigen::MatrixXd noisy = mr::AddNormalNoise(V, F, 0.3 * 2.0 / n, 1);
+  const double before = PeakMemoryMiB();
+  mr::DenoiseOptions options;
+  const mr::DenoiseResult r = mr::Denoise(noisy, F, options);
+  int factorizations = 0;
+  for (const auto& it : r.iterations) factorizations += it.num_factorizations;
+  std::printf("| %ld | %ld | %.2f | %.2f | %.2f | %zu | %d | %.0f | %.0f |\n", F.rows(), V.rows(),
+              r.total_seconds, r.setup_seconds, r.solve_seconds, r.iterations.size(),
+              factorizations, before, PeakMemoryMiB());
+  return 0;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  try {
+    const std::string mode = argc > 1 ? argv[1] : "quality";
+    if (std::getenv("MR_VERBOSE") != nullptr) mr::SetLogLevel(mr::LogLevel::kVerbose);
+    if (mode == "quality") return Quality(argc > 2 ? argv[2] : MR_SHARED_DIR "/data/models", "", "");
+    if (mode == "one" && argc > 2) {
+      return Quality(MR_SHARED_DIR "/data/models", argv[2], argc > 3 ? argv[3] : "lp");
+    }
+    if (mode == "speed" && argc > 2) return Speed(std::stol(argv[2]));
+    std::fprintf(stderr, "usage: denoise_benchmark quality [MODELS_DIR] | speed NUM_FACES\n");
+    return 1;
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "ERROR: %s\n", e.what());
+    return 1;
+  }
+}

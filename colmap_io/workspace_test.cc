@@ -1,0 +1,295 @@
+#include "colmap_io/workspace.h"
+
+#include <chrono>
+#include <filesystem>
+#include <thread>
+#include <fstream>
+
+#include <gtest/gtest.h>
+#include <opencv2/imgcodecs.hpp>
+
+#include "colmap_io/test_models.h"
+#include "colmap_io/undistortion.h"
+#include "util/error.h"
+#include "util/file.h"
+
+namespace mr {
+namespace {
+
+using test::TempDir;
+namespace fs = std::filesystem;
+
+template <typename Fn>
+void ExpectInputError(Fn fn, const std::vector<std::string>& parts) {
+  try {
+    fn();
+    ADD_FAILURE() << "no InputError thrown";
+  } catch (const InputError& e) {
+    const std::string what = e.what();
+    for (const std::string& p : parts) {
+      EXPECT_NE(what.find(p), std::string::npos) << "'" << p << "' not in: " << what;
+    }
+  }
+}
+
+// A model of 64x48 images "c.png", "a.png", "sub/b.png" (ids 1, 2, 3).
+Reconstruction MakeModel(CameraModel model, const std::vector<double>& params) {
+  Reconstruction r;
+  Camera camera;
+  camera.camera_id = 1;
+  camera.model = model;
+  camera.width = 64;
+  camera.height = 48;
+  camera.params = params;
+  r.cameras[1] = camera;
+  const char* names[] = {"c.png", "a.png", "sub/b.png"};
+  for (uint32_t id = 1; id <= 3; ++id) {
+    Image image;
+    image.image_id = id;
+    image.camera_id = 1;
+    image.name = names[id - 1];
+    image.tvec = Eigen::Vector3d(0.1 * id, 0, 0);
+    r.images[id] = image;
+  }
+  return r;
+}
+
+Reconstruction PinholeModel() { return MakeModel(CameraModel::kPinhole, {60, 60, 32, 24}); }
+Reconstruction DistortedModel(double k = -0.05) {
+  return MakeModel(CameraModel::kSimpleRadial, {60, 32, 24, k});
+}
+
+void WriteImages(const std::string& dir, const Reconstruction& model, int width = 64) {
+  for (const auto& [id, image] : model.images) {
+    const std::string path = dir + "/" + image.name;
+    fs::create_directories(fs::path(path).parent_path());
+    cv::Mat m(48, width, CV_8UC3, cv::Scalar(10 * id, 20, 30));
+    ASSERT_TRUE(cv::imwrite(path, m));
+  }
+}
+
+// images/ + sparse/ (dense workspace) or images/ + sparse/0 (sparse project).
+std::string MakeWorkspace(const TempDir& dir, const Reconstruction& model, const std::string& sparse,
+                          bool text = false) {
+  const std::string images = dir.Sub("images");
+  WriteImages(images, model);
+  const std::string s = dir.Sub(sparse);
+  if (text) {
+    WriteSparseModelText(s, model);
+  } else {
+    WriteSparseModelBinary(s, model);
+  }
+  return dir.path();
+}
+
+TEST(WorkspaceOptions, DefaultsAreValid) { EXPECT_TRUE(WorkspaceOptions().Check()); }
+
+TEST(Workspace, DenseWorkspace) {
+  TempDir dir("ws_dense");
+  const std::string root = MakeWorkspace(dir, PinholeModel(), "sparse");
+  const Workspace ws = OpenWorkspace(root);
+  EXPECT_EQ(ws.root, root);
+  EXPECT_EQ(ws.image_dir, root + "/images");
+  EXPECT_EQ(ws.sparse_dir, root + "/sparse");
+  EXPECT_TRUE(ws.mask_dir.empty());
+  EXPECT_TRUE(ws.undistortion.empty());
+  EXPECT_EQ(ws.image_ids, (std::vector<uint32_t>{2, 1, 3}));  // a, c, sub/b by name
+  EXPECT_EQ(ws.ImagePath(3), root + "/images/sub/b.png");
+  const cv::Mat color = ws.ReadImage(1, false), gray = ws.ReadImage(1, true);
+  EXPECT_EQ(color.type(), CV_8UC3);
+  EXPECT_EQ(gray.type(), CV_8UC1);
+  EXPECT_EQ(color.cols, 64);
+  EXPECT_EQ(color.at<cv::Vec3b>(0, 0)[0], 10);
+  EXPECT_TRUE(ws.ReadMask(1).empty());
+  EXPECT_EQ(ws.MaskPath(1), "");
+
+  EXPECT_EQ(ws.DefaultMeshPath(), "");
+  std::ofstream(root + "/meshed-delaunay.ply") << "ply";
+  EXPECT_EQ(ws.DefaultMeshPath(), root + "/meshed-delaunay.ply");
+  std::ofstream(root + "/meshed-poisson.ply") << "ply";
+  EXPECT_EQ(ws.DefaultMeshPath(), root + "/meshed-poisson.ply");
+}
+
+TEST(Workspace, DenseWorkspaceTextModel) {
+  TempDir dir("ws_dense_txt");
+  const std::string root = MakeWorkspace(dir, PinholeModel(), "sparse", true);
+  const Workspace ws = OpenWorkspace(root);
+  EXPECT_EQ(ws.model.images.size(), 3u);
+}
+
+TEST(Workspace, PinholeSparseProject) {
+  TempDir dir("ws_sparse_pinhole");
+  const std::string root = MakeWorkspace(dir, PinholeModel(), "sparse/0");
+  const Workspace ws = OpenWorkspace(root);
+  EXPECT_EQ(ws.sparse_dir, root + "/sparse/0");
+  EXPECT_TRUE(ws.undistortion.empty());
+  EXPECT_FALSE(ExistsDir(root + "/mesh_refiner_undistorted"));
+}
+
+TEST(Workspace, DistortedSparseProjectIsUndistorted) {
+  TempDir dir("ws_sparse_distorted");
+  const std::string root = MakeWorkspace(dir, DistortedModel(), "sparse/0");
+  const std::string out = root + "/mesh_refiner_undistorted";
+  Workspace ws = OpenWorkspace(root);
+  EXPECT_EQ(ws.root, out);
+  EXPECT_EQ(ws.image_dir, out + "/images");
+  EXPECT_EQ(ws.sparse_dir, out + "/sparse");
+  EXPECT_NE(ws.undistortion.find("undistorted 3 images with built-in camera model equations"),
+            std::string::npos)
+      << ws.undistortion;
+  EXPECT_EQ(ws.model.cameras.at(1).model, CameraModel::kPinhole);
+  EXPECT_EQ(ws.model.cameras.at(1).params, (std::vector<double>{60, 60, 32, 24}));
+  EXPECT_EQ(ws.ReadImage(3, false).cols, 64);
+  // The user's files are untouched.
+  EXPECT_EQ(ReadSparseModel(root + "/sparse/0").cameras.at(1).model, CameraModel::kSimpleRadial);
+
+  // The project's own mesh is the default mesh.
+  EXPECT_EQ(ws.DefaultMeshPath(), "");
+  std::ofstream(root + "/meshed-poisson.ply") << "ply";
+  EXPECT_EQ(ws.DefaultMeshPath(), root + "/meshed-poisson.ply");
+
+  // Opening again reuses the complete output.
+  const auto stamp = fs::last_write_time(out + "/images/a.png");
+  ws = OpenWorkspace(root);
+  EXPECT_NE(ws.undistortion.find("reused"), std::string::npos) << ws.undistortion;
+  EXPECT_EQ(fs::last_write_time(out + "/images/a.png"), stamp);
+
+  // A changed model is undistorted again.
+  WriteSparseModelBinary(root + "/sparse/0", DistortedModel(-0.07));
+  ws = OpenWorkspace(root);
+  EXPECT_NE(ws.undistortion.find("undistorted 3 images"), std::string::npos) << ws.undistortion;
+
+  // Replaced source images are undistorted again.
+  std::this_thread::sleep_for(std::chrono::milliseconds(20));
+  ASSERT_TRUE(cv::imwrite(root + "/images/a.png", cv::Mat(48, 64, CV_8UC3, cv::Scalar(1, 2, 3))));
+  ws = OpenWorkspace(root);
+  EXPECT_NE(ws.undistortion.find("undistorted 3 images"), std::string::npos) << ws.undistortion;
+
+  // An interrupted run (partial marker, no completion marker) is redone.
+  fs::remove(out + "/" + kUndistortionMarker);
+  std::ofstream(out + "/" + kUndistortionPartialMarker) << "x";
+  ws = OpenWorkspace(root);
+  EXPECT_NE(ws.undistortion.find("undistorted 3 images"), std::string::npos) << ws.undistortion;
+}
+
+TEST(Workspace, NeverOverwritesUserFolder) {
+  TempDir dir("ws_user_folder");
+  const std::string root = MakeWorkspace(dir, DistortedModel(), "sparse/0");
+  dir.Sub("mesh_refiner_undistorted");
+  std::ofstream(root + "/mesh_refiner_undistorted/notes.txt") << "mine";
+  ExpectInputError([&] { OpenWorkspace(root); }, {"mesh_refiner_undistorted", "will not overwrite"});
+  EXPECT_EQ(ReadFileToString(root + "/mesh_refiner_undistorted/notes.txt"), "mine");
+}
+
+TEST(Workspace, Masks) {
+  TempDir dir("ws_masks");
+  const std::string root = MakeWorkspace(dir, PinholeModel(), "sparse");
+  const std::string masks = dir.Sub("masks");
+  ASSERT_TRUE(cv::imwrite(masks + "/a.png.png", cv::Mat(48, 64, CV_8UC1, cv::Scalar(255))));
+  Workspace ws = OpenWorkspace(root);
+  EXPECT_EQ(ws.mask_dir, masks);
+  EXPECT_EQ(ws.MaskPath(2), masks + "/a.png.png");
+  EXPECT_EQ(ws.ReadMask(2).at<uint8_t>(3, 3), 255);
+  EXPECT_TRUE(ws.ReadMask(1).empty());  // c.png has no mask
+
+  // An explicit folder wins; a wrongly sized mask is refused on reading.
+  const std::string other = dir.Sub("other_masks");
+  ASSERT_TRUE(cv::imwrite(other + "/c.png.png", cv::Mat(10, 10, CV_8UC1, cv::Scalar(255))));
+  WorkspaceOptions options;
+  options.mask_path = other;
+  ws = OpenWorkspace(root, options);
+  EXPECT_EQ(ws.mask_dir, other);
+  ExpectInputError([&] { ws.ReadMask(1); }, {"c.png.png", "10x10"});
+
+  options.mask_path = root + "/nope";
+  ExpectInputError([&] { OpenWorkspace(root, options); }, {"nope", "mask folder does not exist"});
+}
+
+TEST(Workspace, MasksOfDistortedProjectAreUndistorted) {
+  TempDir dir("ws_masks_distorted");
+  const std::string root = MakeWorkspace(dir, DistortedModel(), "sparse/0");
+  const std::string masks = dir.Sub("masks");
+  ASSERT_TRUE(cv::imwrite(masks + "/a.png.png", cv::Mat(48, 64, CV_8UC1, cv::Scalar(255))));
+  const Workspace ws = OpenWorkspace(root);
+  EXPECT_EQ(ws.mask_dir, root + "/mesh_refiner_undistorted/masks");
+  EXPECT_EQ(ws.ReadMask(2).at<uint8_t>(24, 32), 255);
+  EXPECT_TRUE(ws.ReadMask(1).empty());
+}
+
+TEST(Workspace, LowestNumberedSparseModel) {
+  TempDir dir("ws_sparse_numbered");
+  const std::string root = MakeWorkspace(dir, PinholeModel(), "sparse/3");
+  Reconstruction other = PinholeModel();
+  other.images.erase(3);
+  WriteSparseModelBinary(dir.Sub("sparse/12"), other);
+  dir.Sub("sparse/1");  // empty: ignored
+  EXPECT_EQ(OpenWorkspace(root).sparse_dir, root + "/sparse/3");
+}
+
+TEST(Workspace, StereoMasksFallback) {
+  TempDir dir("ws_stereo_masks");
+  const std::string root = MakeWorkspace(dir, PinholeModel(), "sparse");
+  const std::string masks = dir.Sub("stereo/masks");
+  ASSERT_TRUE(cv::imwrite(masks + "/c.png.png", cv::Mat(48, 64, CV_8UC1, cv::Scalar(7))));
+  const Workspace ws = OpenWorkspace(root);
+  EXPECT_EQ(ws.mask_dir, masks);
+  EXPECT_EQ(ws.ReadMask(1).at<uint8_t>(0, 0), 7);
+}
+
+TEST(Workspace, MissingFolder) {
+  ExpectInputError([&] { OpenWorkspace("/nonexistent/ws"); },
+                   {"/nonexistent/ws", "workspace folder does not exist"});
+}
+
+TEST(Workspace, NoImagesFolder) {
+  TempDir dir("ws_no_images");
+  WriteSparseModelBinary(dir.Sub("sparse"), PinholeModel());
+  ExpectInputError([&] { OpenWorkspace(dir.path()); }, {"no images folder", "images"});
+}
+
+TEST(Workspace, NoSparseModel) {
+  TempDir dir("ws_no_sparse");
+  WriteImages(dir.Sub("images"), PinholeModel());
+  ExpectInputError([&] { OpenWorkspace(dir.path()); }, {"no sparse model", "sparse/0"});
+  dir.Sub("sparse/0");
+  ExpectInputError([&] { OpenWorkspace(dir.path()); }, {"no sparse model"});
+}
+
+TEST(Workspace, MissingImages) {
+  TempDir dir("ws_missing_images");
+  const std::string root = MakeWorkspace(dir, PinholeModel(), "sparse");
+  fs::remove(root + "/images/a.png");
+  fs::remove(root + "/images/sub/b.png");
+  ExpectInputError([&] { OpenWorkspace(root); }, {"2 of 3 images", "a.png", "sub/b.png"});
+}
+
+TEST(Workspace, ZeroRegisteredImages) {
+  TempDir dir("ws_zero_images");
+  Reconstruction model = PinholeModel();
+  model.images.clear();
+  MakeWorkspace(dir, model, "sparse");
+  ExpectInputError([&] { OpenWorkspace(dir.path()); }, {"zero registered images"});
+}
+
+TEST(Workspace, WrongImageSize) {
+  TempDir dir("ws_image_size");
+  const std::string root = MakeWorkspace(dir, PinholeModel(), "sparse");
+  ASSERT_TRUE(cv::imwrite(root + "/images/a.png", cv::Mat(48, 50, CV_8UC3, cv::Scalar(0))));
+  const Workspace ws = OpenWorkspace(root);
+  ExpectInputError([&] { ws.ReadImage(2, true); }, {"a.png", "50x48", "64x48"});
+}
+
+TEST(Workspace, CustomImageFolder) {
+  TempDir dir("ws_custom_images");
+  const Reconstruction model = PinholeModel();
+  WriteSparseModelBinary(dir.Sub("sparse"), model);
+  WriteImages(dir.Sub("elsewhere"), model);
+  ExpectInputError([&] { OpenWorkspace(dir.path()); }, {"no images folder"});
+  WorkspaceOptions options;
+  options.image_path = dir.path() + "/elsewhere";
+  const Workspace ws = OpenWorkspace(dir.path(), options);
+  EXPECT_EQ(ws.ImagePath(1), dir.path() + "/elsewhere/c.png");
+}
+
+}  // namespace
+}  // namespace mr

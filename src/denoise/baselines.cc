@@ -1,0 +1,173 @@
+#include "denoise/baselines.h"
+
+#include <algorithm>
+#include <cmath>
+#include <vector>
+
+#include <Eigen/Geometry>
+
+namespace mr {
+namespace {
+
+// Compressed adjacency lists: neighbours of i are adj[offset[i] .. offset[i+1]).
+struct Csr {
+  std::vector<int> offset, adj;
+};
+
+Csr VertexNeighbours(const Eigen::MatrixXi& F, int n) {
+  std::vector<std::pair<int, int>> pairs;
+  pairs.reserve(static_cast<size_t>(F.rows()) * 6);
+  for (int f = 0; f < F.rows(); ++f) {
+    for (int k = 0; k < 3; ++k) {
+      const int a = F(f, k), b = F(f, (k + 1) % 3);
+      if (a == b) continue;
+      pairs.emplace_back(a, b);
+      pairs.emplace_back(b, a);
+    }
+  }
+  std::sort(pairs.begin(), pairs.end());
+  pairs.erase(std::unique(pairs.begin(), pairs.end()), pairs.end());
+  Csr csr;
+  csr.offset.assign(n + 1, 0);
+  for (const auto& p : pairs) ++csr.offset[p.first + 1];
+  for (int i = 0; i < n; ++i) csr.offset[i + 1] += csr.offset[i];
+  csr.adj.resize(pairs.size());
+  for (size_t i = 0; i < pairs.size(); ++i) csr.adj[i] = pairs[i].second;
+  return csr;
+}
+
+// Faces incident to each vertex.
+Csr VertexFaces(const Eigen::MatrixXi& F, int n) {
+  Csr csr;
+  csr.offset.assign(n + 1, 0);
+  for (int f = 0; f < F.rows(); ++f) {
+    for (int k = 0; k < 3; ++k) ++csr.offset[F(f, k) + 1];
+  }
+  for (int i = 0; i < n; ++i) csr.offset[i + 1] += csr.offset[i];
+  csr.adj.resize(csr.offset[n]);
+  std::vector<int> fill(csr.offset.begin(), csr.offset.end() - 1);
+  for (int f = 0; f < F.rows(); ++f) {
+    for (int k = 0; k < 3; ++k) csr.adj[fill[F(f, k)]++] = f;
+  }
+  return csr;
+}
+
+Eigen::MatrixXd Umbrella(const Csr& nb, const Eigen::MatrixXd& X) {
+  const int n = static_cast<int>(X.rows());
+  Eigen::MatrixXd L = Eigen::MatrixXd::Zero(n, 3);
+#pragma omp parallel for schedule(static) if (n > 50000)
+  for (int i = 0; i < n; ++i) {
+    const int b = nb.offset[i], e = nb.offset[i + 1];
+    if (e == b) continue;
+    Eigen::RowVector3d s = Eigen::RowVector3d::Zero();
+    for (int j = b; j < e; ++j) s += X.row(nb.adj[j]);
+    L.row(i) = s / (e - b) - X.row(i);
+  }
+  return L;
+}
+
+}  // namespace
+
+Eigen::MatrixXd LaplacianSmooth(const Eigen::MatrixXd& V, const Eigen::MatrixXi& F,
+                                int iterations, double w1, double w2) {
+  const Csr nb = VertexNeighbours(F, static_cast<int>(V.rows()));
+  Eigen::MatrixXd X = V;
+  for (int it = 0; it < iterations; ++it) {
+    const Eigen::MatrixXd L = Umbrella(nb, X);
+    if (w2 > 0) {
+      X += w1 * L - w2 * Umbrella(nb, L);
+    } else {
+      X += w1 * L;
+    }
+  }
+  return X;
+}
+
+Eigen::MatrixXd BilateralNormalFilter(const Eigen::MatrixXd& V, const Eigen::MatrixXi& F,
+                                      int normal_iterations, int vertex_iterations,
+                                      double normal_sigma, double spatial_sigma) {
+  const int n = static_cast<int>(V.rows()), nf = static_cast<int>(F.rows());
+  if (nf == 0) return V;
+  const Csr vf = VertexFaces(F, n);
+  // Face neighbourhoods: faces sharing a vertex (Zheng et al.'s local scheme).
+  std::vector<std::vector<int>> ring(nf);
+#pragma omp parallel for schedule(dynamic, 256) if (nf > 50000)
+  for (int f = 0; f < nf; ++f) {
+    std::vector<int>& r = ring[f];
+    for (int k = 0; k < 3; ++k) {
+      const int v = F(f, k);
+      for (int j = vf.offset[v]; j < vf.offset[v + 1]; ++j) {
+        if (vf.adj[j] != f) r.push_back(vf.adj[j]);
+      }
+    }
+    std::sort(r.begin(), r.end());
+    r.erase(std::unique(r.begin(), r.end()), r.end());
+  }
+  Eigen::MatrixXd X = V;
+  auto centroids_normals_areas = [&](Eigen::MatrixXd* C, Eigen::MatrixXd* N, Eigen::VectorXd* A) {
+    C->resize(nf, 3);
+    N->resize(nf, 3);
+    A->resize(nf);
+#pragma omp parallel for schedule(static) if (n > 50000)
+    for (int f = 0; f < nf; ++f) {
+      const Eigen::Vector3d a = X.row(F(f, 0)), b = X.row(F(f, 1)), c = X.row(F(f, 2));
+      const Eigen::Vector3d cr = (b - a).cross(c - a);
+      const double len = cr.norm();
+      C->row(f) = (a + b + c).transpose() / 3.0;
+      N->row(f) = len > 0 ? Eigen::RowVector3d(cr.transpose() / len) : Eigen::RowVector3d::Zero();
+      (*A)(f) = 0.5 * len;
+    }
+  };
+  Eigen::MatrixXd C, N;
+  Eigen::VectorXd A;
+  centroids_normals_areas(&C, &N, &A);
+  // Spatial sigma: mean distance between centroids of faces sharing a vertex.
+  double dsum = 0;
+  long dcount = 0;
+  for (int f = 0; f < nf; ++f) {
+    for (int g : ring[f]) {
+      dsum += (C.row(f) - C.row(g)).norm();
+      ++dcount;
+    }
+  }
+  const double ss = spatial_sigma * (dcount > 0 ? dsum / dcount : 1.0);
+  const double inv_ss2 = 1.0 / (2 * ss * ss), inv_sr2 = 1.0 / (2 * normal_sigma * normal_sigma);
+  for (int it = 0; it < normal_iterations; ++it) {
+    Eigen::MatrixXd Nn(nf, 3);
+#pragma omp parallel for schedule(static) if (n > 50000)
+    for (int f = 0; f < nf; ++f) {
+      Eigen::RowVector3d s = A(f) * N.row(f);
+      for (int g : ring[f]) {
+        const double w = A(g) * std::exp(-(C.row(f) - C.row(g)).squaredNorm() * inv_ss2 -
+                                         (N.row(f) - N.row(g)).squaredNorm() * inv_sr2);
+        s += w * N.row(g);
+      }
+      const double len = s.norm();
+      Nn.row(f) = len > 0 ? Eigen::RowVector3d(s / len) : N.row(f);
+    }
+    N = Nn;
+  }
+  // Vertex update (Sun et al. 2007): x_i += 1/|F_i| sum_f n_f (n_f . (c_f - x_i)).
+  for (int it = 0; it < vertex_iterations; ++it) {
+    Eigen::MatrixXd Xn = X;
+#pragma omp parallel for schedule(static) if (n > 50000)
+    for (int v = 0; v < n; ++v) {
+      const int b = vf.offset[v], e = vf.offset[v + 1];
+      if (e == b) continue;
+      Eigen::RowVector3d d = Eigen::RowVector3d::Zero();
+      for (int j = b; j < e; ++j) {
+        const int f = vf.adj[j];
+        d += N.row(f) * N.row(f).dot(C.row(f) - X.row(v));
+      }
+      Xn.row(v) += d / (e - b);
+    }
+    X = Xn;
+#pragma omp parallel for schedule(static) if (n > 50000)
+    for (int f = 0; f < nf; ++f) {
+      C.row(f) = (X.row(F(f, 0)) + X.row(F(f, 1)) + X.row(F(f, 2))) / 3.0;
+    }
+  }
+  return X;
+}
+
+}  // namespace mr

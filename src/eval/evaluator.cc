@@ -1,0 +1,216 @@
+#include "eval/evaluator.h"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdint>
+#include <cstdio>
+#include <vector>
+
+#include <CGAL/AABB_traits.h>
+#include <CGAL/AABB_tree.h>
+#include <CGAL/AABB_triangle_primitive.h>
+#include <CGAL/Simple_cartesian.h>
+
+#include "geometry/mesh.h"
+#include "util/error.h"
+#include "util/logging.h"
+
+namespace mr {
+namespace {
+
+using Kernel = CGAL::Simple_cartesian<double>;
+using Point = Kernel::Point_3;
+using Triangle = Kernel::Triangle_3;
+using TriangleIterator = std::vector<Triangle>::const_iterator;
+using Primitive = CGAL::AABB_triangle_primitive<Kernel, TriangleIterator>;
+using Tree = CGAL::AABB_tree<CGAL::AABB_traits<Kernel, Primitive>>;
+
+// A point sampled on a mesh and the face it lies on.
+struct Sample {
+  Eigen::Vector3d point;
+  int face;
+};
+
+// Uniform double in [0, 1) from 53 random bits (the same on every platform,
+// unlike std::uniform_real_distribution).
+class Random {
+ public:
+  explicit Random(uint64_t seed) : state_(seed) {}
+  double Uniform() { return static_cast<double>(Next() >> 11) * (1.0 / 9007199254740992.0); }
+
+ private:
+  // SplitMix64.
+  uint64_t Next() {
+    uint64_t z = (state_ += 0x9E3779B97F4A7C15ull);
+    z = (z ^ (z >> 30)) * 0xBF58476D1CE4E5B9ull;
+    z = (z ^ (z >> 27)) * 0x94D049BB133111EBull;
+    return z ^ (z >> 31);
+  }
+  uint64_t state_;
+};
+
+// Area-uniform samples on the mesh (faces chosen with probability
+// proportional to their area, uniform barycentric position inside).
+std::vector<Sample> SampleMesh(const Eigen::MatrixXd& V, const Eigen::MatrixXi& F,
+                               const Eigen::VectorXd& areas, int num_samples, uint64_t seed) {
+  std::vector<double> cumulative(F.rows());
+  double total = 0;
+  for (Eigen::Index f = 0; f < F.rows(); ++f) {
+    total += areas(f);
+    cumulative[f] = total;
+  }
+  Random random(seed);
+  std::vector<Sample> samples(num_samples);
+  for (int i = 0; i < num_samples; ++i) {
+    const double target = random.Uniform() * total;
+    int f = static_cast<int>(std::upper_bound(cumulative.begin(), cumulative.end(), target) -
+                             cumulative.begin());
+    f = std::min(f, static_cast<int>(F.rows()) - 1);
+    while (areas(f) <= 0 && f > 0) --f;  // never a zero-area face
+    const double r1 = std::sqrt(random.Uniform());
+    const double r2 = random.Uniform();
+    const Eigen::Vector3d a = V.row(F(f, 0)), b = V.row(F(f, 1)), c = V.row(F(f, 2));
+    samples[i].point = (1 - r1) * a + r1 * (1 - r2) * b + r1 * r2 * c;
+    samples[i].face = f;
+  }
+  return samples;
+}
+
+void CheckMesh(const Eigen::MatrixXd& V, const Eigen::MatrixXi& F, const char* name,
+               Eigen::VectorXd* areas) {
+  if (F.rows() == 0) MR_THROW_INPUT << name << " mesh has no faces";
+  if (V.cols() != 3 || F.cols() != 3) {
+    MR_THROW_INPUT << name << " mesh must be #V by 3 and #F by 3 (got " << V.cols() << " and "
+                   << F.cols() << " columns)";
+  }
+  if (F.minCoeff() < 0 || F.maxCoeff() >= V.rows()) {
+    MR_THROW_INPUT << name << " mesh has a face index out of range [0, " << V.rows() << ")";
+  }
+  if (!V.allFinite()) MR_THROW_INPUT << name << " mesh has non-finite vertex coordinates";
+  *areas = FaceAreas(V, F);
+  if (!(areas->sum() > 0)) MR_THROW_INPUT << name << " mesh has zero total area";
+}
+
+struct Distances {
+  std::vector<double> distance;   // per sample
+  std::vector<double> angle_deg;  // per sample; NaN where a normal is undefined
+};
+
+// Distance from every sample to the target mesh, and the angle between the
+// sample's face normal and the normal of the closest target triangle.
+Distances Query(const std::vector<Sample>& samples, const Eigen::MatrixXd& sample_normals,
+                const Eigen::MatrixXd& V, const Eigen::MatrixXi& F) {
+  std::vector<Triangle> triangles;
+  triangles.reserve(F.rows());
+  for (Eigen::Index f = 0; f < F.rows(); ++f) {
+    const auto p = [&](int k) { return Point(V(F(f, k), 0), V(F(f, k), 1), V(F(f, k), 2)); };
+    triangles.emplace_back(p(0), p(1), p(2));
+  }
+  const Eigen::MatrixXd target_normals = FaceNormals(V, F);
+  Tree tree(triangles.cbegin(), triangles.cend());
+  tree.build();
+  tree.accelerate_distance_queries();
+
+  Distances result;
+  const int n = static_cast<int>(samples.size());
+  result.distance.resize(n);
+  result.angle_deg.resize(n);
+#ifdef _OPENMP
+#pragma omp parallel for schedule(dynamic, 1024)
+#endif
+  for (int i = 0; i < n; ++i) {
+    const Eigen::Vector3d& q = samples[i].point;
+    const Point query(q.x(), q.y(), q.z());
+    const auto closest = tree.closest_point_and_primitive(query);
+    const Eigen::Vector3d c(closest.first.x(), closest.first.y(), closest.first.z());
+    result.distance[i] = (c - q).norm();
+    const int target_face = static_cast<int>(closest.second - triangles.cbegin());
+    const Eigen::Vector3d a = sample_normals.row(samples[i].face);
+    const Eigen::Vector3d b = target_normals.row(target_face);
+    if (a.squaredNorm() > 0.5 && b.squaredNorm() > 0.5) {
+      const double cosine = std::max(-1.0, std::min(1.0, a.dot(b)));
+      result.angle_deg[i] = std::acos(cosine) * 180.0 / M_PI;
+    } else {
+      result.angle_deg[i] = std::nan("");
+    }
+  }
+  return result;
+}
+
+double Mean(const std::vector<double>& values) {
+  double sum = 0;
+  for (double v : values) sum += v;
+  return values.empty() ? 0 : sum / values.size();
+}
+
+}  // namespace
+
+bool EvaluationOptions::Check() const {
+  if (!(threshold > 0) || !std::isfinite(threshold)) {
+    MR_THROW_INPUT << "EvaluationOptions::threshold = " << threshold
+                   << ". Violated constraint: threshold > 0";
+  }
+  if (num_samples < 1) {
+    MR_THROW_INPUT << "EvaluationOptions::num_samples = " << num_samples
+                   << ". Violated constraint: num_samples >= 1";
+  }
+  if (seed < 0) {
+    MR_THROW_INPUT << "EvaluationOptions::seed = " << seed << ". Violated constraint: seed >= 0";
+  }
+  return true;
+}
+
+std::string EvaluationResult::ToJson() const {
+  char text[512];
+  std::snprintf(text, sizeof(text),
+                "{\"accuracy90\": %.9g, \"completeness\": %.6f, \"chamfer\": %.9g, "
+                "\"normal_deg\": %.6f, \"mean_accuracy\": %.9g, \"faces\": %d}",
+                accuracy90, completeness, chamfer, normal_deg, mean_accuracy, faces);
+  return text;
+}
+
+EvaluationResult EvaluateMesh(const Eigen::MatrixXd& V, const Eigen::MatrixXi& F,
+                              const Eigen::MatrixXd& gt_V, const Eigen::MatrixXi& gt_F,
+                              const EvaluationOptions& options) {
+  options.Check();
+  Eigen::VectorXd areas, gt_areas;
+  CheckMesh(V, F, "Evaluated", &areas);
+  CheckMesh(gt_V, gt_F, "Ground-truth", &gt_areas);
+
+  const uint64_t seed = static_cast<uint64_t>(options.seed);
+  const std::vector<Sample> samples = SampleMesh(V, F, areas, options.num_samples, 2 * seed);
+  const std::vector<Sample> gt_samples =
+      SampleMesh(gt_V, gt_F, gt_areas, options.num_samples, 2 * seed + 1);
+
+  const Distances to_gt = Query(samples, FaceNormals(V, F), gt_V, gt_F);
+  const Distances to_recon = Query(gt_samples, FaceNormals(gt_V, gt_F), V, F);
+
+  EvaluationResult result;
+  result.faces = static_cast<int>(F.rows());
+  result.mean_accuracy = Mean(to_gt.distance);
+  result.chamfer = result.mean_accuracy + Mean(to_recon.distance);
+
+  std::vector<double> sorted = to_gt.distance;
+  const size_t k = static_cast<size_t>(std::ceil(0.9 * sorted.size())) - 1;  // nearest rank
+  std::nth_element(sorted.begin(), sorted.begin() + k, sorted.end());
+  result.accuracy90 = sorted[k];
+
+  size_t within = 0;
+  for (double d : to_recon.distance) within += d <= options.threshold ? 1 : 0;
+  result.completeness = 100.0 * within / to_recon.distance.size();
+
+  double angle_sum = 0;
+  size_t angle_count = 0;
+  for (double a : to_gt.angle_deg) {
+    if (std::isfinite(a)) {
+      angle_sum += a;
+      ++angle_count;
+    }
+  }
+  result.normal_deg = angle_count > 0 ? angle_sum / angle_count : 0;
+  MR_LOG(VERBOSE) << "Evaluated " << F.rows() << " faces against " << gt_F.rows()
+                  << " ground-truth faces with " << options.num_samples << " samples each";
+  return result;
+}
+
+}  // namespace mr

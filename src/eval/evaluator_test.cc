@@ -1,0 +1,297 @@
+#include "eval/evaluator.h"
+
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <map>
+#include <string>
+#include <utility>
+
+#include <Eigen/Geometry>
+#include <gtest/gtest.h>
+
+#include "colmap_io/mesh_io.h"
+#include "util/error.h"
+#include "util/file.h"
+
+namespace mr {
+namespace {
+
+struct Mesh {
+  Eigen::MatrixXd V;
+  Eigen::MatrixXi F;
+};
+
+// Icosahedron subdivided `levels` times, vertices on the unit sphere,
+// counter-clockwise seen from outside.
+Mesh Icosphere(int levels) {
+  const double t = (1.0 + std::sqrt(5.0)) / 2.0;
+  std::vector<Eigen::Vector3d> v = {{-1, t, 0}, {1, t, 0}, {-1, -t, 0}, {1, -t, 0},
+                                    {0, -1, t}, {0, 1, t}, {0, -1, -t}, {0, 1, -t},
+                                    {t, 0, -1}, {t, 0, 1}, {-t, 0, -1}, {-t, 0, 1}};
+  std::vector<Eigen::Vector3i> f = {{0, 11, 5}, {0, 5, 1},  {0, 1, 7},   {0, 7, 10}, {0, 10, 11},
+                                    {1, 5, 9},  {5, 11, 4}, {11, 10, 2}, {10, 7, 6}, {7, 1, 8},
+                                    {3, 9, 4},  {3, 4, 2},  {3, 2, 6},   {3, 6, 8},  {3, 8, 9},
+                                    {4, 9, 5},  {2, 4, 11}, {6, 2, 10},  {8, 6, 7},  {9, 8, 1}};
+  for (auto& p : v) p.normalize();
+  for (int level = 0; level < levels; ++level) {
+    std::map<std::pair<int, int>, int> midpoints;
+    auto midpoint = [&](int a, int b) {
+      const auto key = std::minmax(a, b);
+      auto it = midpoints.find(key);
+      if (it != midpoints.end()) return it->second;
+      v.push_back((v[a] + v[b]).normalized());
+      midpoints[key] = static_cast<int>(v.size()) - 1;
+      return static_cast<int>(v.size()) - 1;
+    };
+    std::vector<Eigen::Vector3i> next;
+    for (const auto& tri : f) {
+      const int ab = midpoint(tri[0], tri[1]), bc = midpoint(tri[1], tri[2]),
+                ca = midpoint(tri[2], tri[0]);
+      next.push_back({tri[0], ab, ca});
+      next.push_back({tri[1], bc, ab});
+      next.push_back({tri[2], ca, bc});
+      next.push_back({ab, bc, ca});
+    }
+    f = next;
+  }
+  Mesh mesh;
+  mesh.V.resize(v.size(), 3);
+  for (size_t i = 0; i < v.size(); ++i) mesh.V.row(i) = v[i].transpose();
+  mesh.F.resize(f.size(), 3);
+  for (size_t i = 0; i < f.size(); ++i) mesh.F.row(i) = f[i].transpose();
+  return mesh;
+}
+
+// n by n grid of squares on [0, 1]^2 at z = 0, normals +z.
+Mesh Plane(int n) {
+  Mesh mesh;
+  mesh.V.resize((n + 1) * (n + 1), 3);
+  for (int y = 0; y <= n; ++y) {
+    for (int x = 0; x <= n; ++x) mesh.V.row(y * (n + 1) + x) << double(x) / n, double(y) / n, 0;
+  }
+  mesh.F.resize(2 * n * n, 3);
+  for (int y = 0; y < n; ++y) {
+    for (int x = 0; x < n; ++x) {
+      const int a = y * (n + 1) + x, b = a + 1, c = a + n + 1, d = c + 1;
+      mesh.F.row(2 * (y * n + x)) << a, b, d;
+      mesh.F.row(2 * (y * n + x) + 1) << a, d, c;
+    }
+  }
+  return mesh;
+}
+
+// Smallest and largest distance from the origin to a face plane.
+std::pair<double, double> FacePlaneDistanceRange(const Mesh& mesh) {
+  double lo = 1e300, hi = 0;
+  for (int f = 0; f < mesh.F.rows(); ++f) {
+    const Eigen::Vector3d a = mesh.V.row(mesh.F(f, 0)), b = mesh.V.row(mesh.F(f, 1)),
+                          c = mesh.V.row(mesh.F(f, 2));
+    const double h = std::abs((b - a).cross(c - a).normalized().dot(a));
+    lo = std::min(lo, h);
+    hi = std::max(hi, h);
+  }
+  return {lo, hi};
+}
+
+TEST(EvaluationOptions, DefaultsAreValid) { EXPECT_TRUE(EvaluationOptions().Check()); }
+
+TEST(EvaluationOptions, InvalidValuesThrow) {
+  EvaluationOptions options;
+  options.threshold = 0;
+  EXPECT_THROW(options.Check(), InputError);
+  options = EvaluationOptions();
+  options.num_samples = 0;
+  try {
+    options.Check();
+    ADD_FAILURE();
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("num_samples = 0. Violated constraint: num_samples >= 1"),
+              std::string::npos);
+  }
+  options = EvaluationOptions();
+  options.seed = -1;
+  EXPECT_THROW(options.Check(), InputError);
+}
+
+// Unit icosphere against the same icosphere scaled by s = 1.01. Both are
+// convex with parallel faces, so (writing h_f for the distance of face f's
+// plane from the origin) every recon->GT distance lies in
+// [(s-1) h_min, (s-1) h_max] and every GT->recon distance in
+// [(s-1) h_min, (s-1)] (lower bound: the supporting plane of the nearest
+// face; upper bound: radial projection onto the inner mesh).
+TEST(EvaluateMesh, SphereAgainstLargerSphere) {
+  const Mesh recon = Icosphere(5);
+  const double s = 1.01;
+  const Eigen::MatrixXd gt_V = s * recon.V;
+  const auto [h_min, h_max] = FacePlaneDistanceRange(recon);
+  ASSERT_GT(h_min, 0.9996);  // level 5: the bounds pin distances to ~4e-6
+  EvaluationOptions options;
+  options.num_samples = 20000;
+  options.threshold = 0.02;
+  const EvaluationResult full = EvaluateMesh(recon.V, recon.F, gt_V, recon.F, options);
+  const double eps = 1e-12;
+  EXPECT_GE(full.accuracy90, (s - 1) * h_min - eps);
+  EXPECT_LE(full.accuracy90, (s - 1) * h_max + eps);
+  EXPECT_GE(full.mean_accuracy, (s - 1) * h_min - eps);
+  EXPECT_LE(full.mean_accuracy, (s - 1) * h_max + eps);
+  EXPECT_GE(full.chamfer, 2 * (s - 1) * h_min - eps);
+  EXPECT_LE(full.chamfer, (s - 1) * h_max + (s - 1) + eps);
+  EXPECT_NEAR(full.accuracy90, 0.01, 5e-6);
+  EXPECT_EQ(full.completeness, 100.0);
+  EXPECT_LT(full.normal_deg, 0.5);
+  EXPECT_EQ(full.faces, recon.F.rows());
+
+  options.threshold = 0.005;
+  const EvaluationResult none = EvaluateMesh(recon.V, recon.F, gt_V, recon.F, options);
+  EXPECT_EQ(none.completeness, 0.0);
+  EXPECT_EQ(none.accuracy90, full.accuracy90);  // the threshold only affects completeness
+}
+
+TEST(EvaluateMesh, IdenticalMeshesGiveZero) {
+  const Mesh mesh = Icosphere(3);
+  EvaluationOptions options;
+  options.num_samples = 5000;
+  options.threshold = 1e-9;
+  const EvaluationResult result = EvaluateMesh(mesh.V, mesh.F, mesh.V, mesh.F, options);
+  EXPECT_LT(result.accuracy90, 1e-12);
+  EXPECT_LT(result.chamfer, 1e-12);
+  EXPECT_EQ(result.completeness, 100.0);
+  EXPECT_LT(result.normal_deg, 1e-3);
+}
+
+TEST(EvaluateMesh, TranslatedPlane) {
+  const Mesh plane = Plane(8);
+  Eigen::MatrixXd moved = plane.V;
+  moved.col(2).array() += 0.1;
+  EvaluationOptions options;
+  options.num_samples = 5000;
+  options.threshold = 0.1 + 1e-9;
+  const EvaluationResult result = EvaluateMesh(plane.V, plane.F, moved, plane.F, options);
+  EXPECT_NEAR(result.accuracy90, 0.1, 1e-12);
+  EXPECT_NEAR(result.mean_accuracy, 0.1, 1e-12);
+  EXPECT_NEAR(result.chamfer, 0.2, 1e-12);
+  EXPECT_EQ(result.completeness, 100.0);
+  EXPECT_LT(result.normal_deg, 1e-3);
+  options.threshold = 0.1 - 1e-9;
+  EXPECT_EQ(EvaluateMesh(plane.V, plane.F, moved, plane.F, options).completeness, 0.0);
+}
+
+TEST(EvaluateMesh, FlippedNormalsGive180Degrees) {
+  const Mesh plane = Plane(4);
+  Eigen::MatrixXi flipped = plane.F;
+  flipped.col(1).swap(flipped.col(2));
+  EvaluationOptions options;
+  options.num_samples = 2000;
+  const EvaluationResult result = EvaluateMesh(plane.V, plane.F, plane.V, flipped, options);
+  EXPECT_NEAR(result.normal_deg, 180.0, 1e-3);
+  EXPECT_LT(result.accuracy90, 1e-12);
+}
+
+// Half of the GT is missing from the reconstruction: completeness ~50%,
+// accuracy unaffected.
+TEST(EvaluateMesh, PartialReconstruction) {
+  const Mesh gt = Plane(10);
+  Mesh half;
+  half.V = gt.V;
+  half.V.col(0) *= 0.5;  // covers x in [0, 0.5]
+  EvaluationOptions options;
+  options.num_samples = 20000;
+  options.threshold = 0.01;
+  const EvaluationResult result = EvaluateMesh(half.V, gt.F, gt.V, gt.F, options);
+  EXPECT_LT(result.accuracy90, 1e-12);
+  // GT samples with x <= 0.51 are within 0.01: 51% of the area; the binomial
+  // standard deviation with 20000 samples is 0.35%.
+  EXPECT_NEAR(result.completeness, 51.0, 1.5);
+}
+
+TEST(EvaluateMesh, DeterministicForSeed) {
+  const Mesh recon = Icosphere(2);
+  const Mesh gt = Icosphere(4);
+  EvaluationOptions options;
+  options.num_samples = 3000;
+  const EvaluationResult a = EvaluateMesh(recon.V, recon.F, gt.V, gt.F, options);
+  const EvaluationResult b = EvaluateMesh(recon.V, recon.F, gt.V, gt.F, options);
+  EXPECT_EQ(a.ToJson(), b.ToJson());
+  options.seed = 7;
+  const EvaluationResult c = EvaluateMesh(recon.V, recon.F, gt.V, gt.F, options);
+  EXPECT_NE(a.mean_accuracy, c.mean_accuracy);
+  EXPECT_NEAR(a.mean_accuracy, c.mean_accuracy, 0.1 * a.mean_accuracy);
+}
+
+TEST(EvaluateMesh, EmptyMesh) {
+  const Mesh mesh = Icosphere(1);
+  const Eigen::MatrixXd no_V(0, 3);
+  const Eigen::MatrixXi no_F(0, 3);
+  EXPECT_THROW(EvaluateMesh(no_V, no_F, mesh.V, mesh.F), InputError);
+  EXPECT_THROW(EvaluateMesh(mesh.V, mesh.F, no_V, no_F), InputError);
+  EXPECT_THROW(EvaluateMesh(mesh.V, no_F, mesh.V, mesh.F), InputError);
+  // Zero area (all vertices at one point).
+  const Eigen::MatrixXd collapsed = Eigen::MatrixXd::Zero(mesh.V.rows(), 3);
+  EXPECT_THROW(EvaluateMesh(collapsed, mesh.F, mesh.V, mesh.F), InputError);
+  Eigen::MatrixXi bad = mesh.F;
+  bad(0, 0) = static_cast<int>(mesh.V.rows());
+  EXPECT_THROW(EvaluateMesh(mesh.V, bad, mesh.V, mesh.F), InputError);
+}
+
+TEST(EvaluationResult, ToJsonIsOneLine) {
+  EvaluationResult result;
+  result.accuracy90 = 0.5;
+  result.faces = 12;
+  const std::string json = result.ToJson();
+  EXPECT_EQ(json.find('\n'), std::string::npos);
+  EXPECT_EQ(json.front(), '{');
+  EXPECT_EQ(json.back(), '}');
+  for (const char* key : {"\"accuracy90\": 0.5", "\"completeness\"", "\"chamfer\"",
+                          "\"normal_deg\"", "\"mean_accuracy\"", "\"faces\": 12"}) {
+    EXPECT_NE(json.find(key), std::string::npos) << key << " in " << json;
+  }
+}
+
+// The command-line program, end to end.
+TEST(MeshEvaluator, CommandLine) {
+  const std::string exe = JoinPaths(MR_BIN_DIR, "mesh_evaluator");
+  if (!ExistsFile(exe)) GTEST_SKIP() << exe << " not built";
+  const std::string dir = JoinPaths(::testing::TempDir(), "mr_evaluator_test");
+  CreateDirIfNotExists(dir);
+  const Mesh plane = Plane(4);
+  TriangleMesh recon, gt;
+  recon.V = plane.V;
+  recon.F = plane.F;
+  gt = recon;
+  gt.V.col(2).array() += 0.25;
+  WriteMesh(JoinPaths(dir, "recon.ply"), recon);
+  WriteMesh(JoinPaths(dir, "gt.obj"), gt);
+  const std::string out = JoinPaths(dir, "out.txt");
+  const std::string err = JoinPaths(dir, "err.txt");
+  const std::string base = "'" + exe + "' --input_path '" + JoinPaths(dir, "recon.ply") + "'";
+  const std::string command = base + " --gt_path '" + JoinPaths(dir, "gt.obj") +
+                              "' --threshold 0.3 --num_samples 1000 --seed 3 > '" + out +
+                              "' 2> '" + err + "'";
+  ASSERT_EQ(std::system(command.c_str()), 0) << ReadFileToString(err);
+  const std::string json = ReadFileToString(out);
+  EXPECT_NE(json.find("\"accuracy90\": 0.25,"), std::string::npos) << json;
+  EXPECT_NE(json.find("\"completeness\": 100.000000"), std::string::npos) << json;
+  EXPECT_NE(json.find("\"faces\": 32}"), std::string::npos) << json;
+
+  // Missing file: one ERROR line, exit status 1.
+  const std::string bad = base + " --gt_path '" + JoinPaths(dir, "nope.ply") + "' > '" + out +
+                          "' 2> '" + err + "'";
+  const int status = std::system(bad.c_str());
+  EXPECT_TRUE(WIFEXITED(status) && WEXITSTATUS(status) == 1);
+  const std::string message = ReadFileToString(err);
+  EXPECT_EQ(message.rfind("ERROR: ", 0), 0u) << message;
+  EXPECT_NE(message.find("nope.ply"), std::string::npos) << message;
+
+  // A point cloud (no faces) is rejected.
+  TriangleMesh cloud = recon;
+  cloud.F.resize(0, 3);
+  WriteMesh(JoinPaths(dir, "cloud.ply"), cloud);
+  const std::string empty = base + " --gt_path '" + JoinPaths(dir, "cloud.ply") + "' > '" + out +
+                            "' 2> '" + err + "'";
+  EXPECT_NE(std::system(empty.c_str()), 0);
+  EXPECT_NE(ReadFileToString(err).find("mesh has no faces"), std::string::npos);
+}
+
+}  // namespace
+}  // namespace mr

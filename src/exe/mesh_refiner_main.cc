@@ -1,0 +1,193 @@
+// mesh_refiner: refines a COLMAP mesh with DCV (Li et al., TIP 2016).
+//
+//   mesh_refiner --workspace_path dense/ [--input_path mesh.ply]
+//                [--output_path dense/meshed-refined.ply] [--Refine.* ...]
+//
+// See docs/mesh_refiner.md for every option.
+
+#include <algorithm>
+#include <cstdio>
+#include <fstream>
+#include <iostream>
+#include <set>
+
+#include "colmap_io/ply.h"
+#include "colmap_io/workspace.h"
+#include "geometry/mesh.h"
+#include "refine/refiner.h"
+#include "refine/view_selection.h"
+#include "render/renderer.h"
+#include "util/error.h"
+#include "util/file.h"
+#include "util/logging.h"
+#include "util/options.h"
+
+namespace mr {
+namespace {
+
+std::set<std::string> ReadNameList(const std::string& path) {
+  std::set<std::string> names;
+  std::ifstream in(path);
+  if (!in) MR_THROW_INPUT << path << ": cannot open the held-out list";
+  std::string line;
+  while (std::getline(in, line)) {
+    const auto b = line.find_first_not_of(" \t\r");
+    if (b == std::string::npos || line[b] == '#') continue;
+    names.insert(line.substr(b, line.find_last_not_of(" \t\r") - b + 1));
+  }
+  return names;
+}
+
+void RegisterRefineOptions(OptionManager* o, RefineOptions* r) {
+  o->Add("Refine.num_levels", &r->num_levels, "image pyramid levels, coarse to fine (1..6)");
+  o->Add("Refine.iterations_per_level", &r->iterations_per_level,
+         "gradient + denoising iterations per level (>= 0)");
+  o->Add("Refine.target_edge_px", &r->target_edge_px,
+         "target triangle edge length in pixels at each level (> 0)");
+  o->Add("Refine.max_faces", &r->max_faces, "face budget (0: 2x input faces, at least 100k)");
+  o->Add("Refine.step", &r->step, "fraction of the Gauss-Newton step per iteration (0, 1]");
+  o->Add("Refine.max_step_px", &r->max_step_px,
+         "largest vertex motion per iteration, in pixel footprints (> 0)");
+  o->Add("Refine.damping", &r->damping, "Levenberg damping relative to the median curvature");
+  o->Add("Refine.similarity", &r->similarity, "dcv (detail-preserving) or zncc");
+  o->Add("Refine.kappa", &r->kappa, "final weight of the detail-preserving term (>= 0)");
+  o->Add("Refine.regularizer", &r->regularizer, "lp (content-aware L_p), laplacian or none");
+  o->Add("Refine.silhouette_weight", &r->silhouette_weight,
+         "weight of the silhouette term when masks exist (>= 0)");
+  o->Add("Refine.cache_mb", &r->cache_mb, "memory budget for cached images and renders (MB)");
+  o->Add("ViewSelection.num_neighbors", &r->view_selection.num_neighbors,
+         "neighbour views per view (1..16)");
+  o->Add("ViewSelection.ideal_angle_deg", &r->view_selection.ideal_angle_deg,
+         "preferred triangulation angle (degrees)");
+  o->Add("Similarity.sigma", &r->similarity_options.sigma,
+         "Gaussian window sigma in pixels");
+  o->Add("Similarity.epsilon", &r->similarity_options.epsilon,
+         "variance regulariser (intensity^2, images in [0,1])");
+  RegisterDenoiseOptions(o, &r->denoise, "Denoise");
+}
+
+// Prints the dry-run summary of a workspace and mesh.
+void PrintSummary(const Workspace& workspace, const ViewSource& source, const TriangleMesh& mesh,
+                  const std::string& input_path) {
+  const Eigen::Vector3d lo = mesh.V.colwise().minCoeff(), hi = mesh.V.colwise().maxCoeff();
+  const std::vector<PinholeView> views = source.Views();
+  const double footprint = MedianFootprint(views, mesh.V, VertexNormals(mesh.V, mesh.F));
+  const double edge = MeanEdgeLength(mesh.V, mesh.F);
+  std::printf("Workspace:   %s\n", workspace.root.c_str());
+  std::printf("Images:      %d registered, %zu used\n", static_cast<int>(workspace.image_ids.size()),
+              views.size());
+  std::printf("Cameras:     %zu\n", workspace.model.cameras.size());
+  std::printf("Masks:       %s\n", workspace.mask_dir.empty() ? "none" : workspace.mask_dir.c_str());
+  if (!workspace.undistortion.empty()) std::printf("Undistorted: %s\n", workspace.undistortion.c_str());
+  std::printf("Mesh:        %s\n", input_path.c_str());
+  std::printf("Vertices:    %d\nFaces:       %d\n", mesh.NumVertices(), mesh.NumFaces());
+  std::printf("Bounding box: [%g, %g, %g] - [%g, %g, %g]\n", lo.x(), lo.y(), lo.z(), hi.x(), hi.y(),
+              hi.z());
+  if (footprint > 0) {
+    std::printf("Mean edge:   %g (%.2f px at full resolution)\n", edge, edge / footprint);
+  } else {
+    std::printf("Mean edge:   %g (the mesh is not visible in any view)\n", edge);
+  }
+}
+
+int Run(int argc, char** argv) {
+  std::string workspace_path, input_path, output_path, mask_path, image_path, holdout_path;
+  bool dry_run = false, verbose = false;
+  RefineOptions refine;
+  OptionManager options("mesh_refiner",
+                        "refines a COLMAP mesh (meshed-poisson.ply) with DCV and writes "
+                        "meshed-refined.ply");
+  options.AddRequired("workspace_path", &workspace_path,
+                      "COLMAP dense workspace (images/, sparse/), or a project with sparse/0");
+  options.Add("input_path", &input_path,
+              "input mesh (default: <workspace>/meshed-poisson.ply, else meshed-delaunay.ply)");
+  options.Add("output_path", &output_path, "output mesh (default: <workspace>/meshed-refined.ply)");
+  options.Add("mask_path", &mask_path, "folder of masks <image name>.png (default: <workspace>/masks if present)");
+  options.Add("image_path", &image_path, "folder of images (default: <workspace>/images)");
+  options.Add("holdout_path", &holdout_path,
+              "text file of image names to leave out of refinement; their photo-consistency is "
+              "reported before and after");
+  options.Add("dry_run", &dry_run, "load and validate the workspace and mesh, print a summary, exit");
+  options.Add("verbose", &verbose, "per-iteration details");
+  RegisterRefineOptions(&options, &refine);
+  if (!options.Parse(argc, argv)) return 0;
+  if (verbose) SetLogLevel(LogLevel::kVerbose);
+  refine.Check();
+
+  WorkspaceOptions ws_options;
+  ws_options.mask_path = mask_path;
+  ws_options.image_path = image_path;
+  const Workspace workspace = OpenWorkspace(workspace_path, ws_options);
+  if (input_path.empty()) {
+    input_path = workspace.DefaultMeshPath();
+    if (input_path.empty()) {
+      MR_THROW_INPUT << workspace_path
+                     << ": no meshed-poisson.ply or meshed-delaunay.ply; run colmap poisson_mesher "
+                        "first or give --input_path";
+    }
+  }
+  if (output_path.empty()) output_path = JoinPaths(workspace_path, "meshed-refined.ply");
+  if (std::filesystem::exists(output_path) && std::filesystem::exists(input_path) &&
+      std::filesystem::equivalent(output_path, input_path)) {
+    MR_THROW_INPUT << "--output_path " << output_path
+                   << " is the input mesh; refusing to overwrite the input";
+  }
+  const std::string output_dir = GetParentDir(output_path);
+  if (!output_dir.empty() && !ExistsDir(output_dir)) {
+    MR_THROW_INPUT << "--output_path " << output_path << ": folder " << output_dir
+                   << " does not exist";
+  }
+
+  const std::set<std::string> holdout =
+      holdout_path.empty() ? std::set<std::string>{} : ReadNameList(holdout_path);
+  const WorkspaceViewSource source(workspace, holdout);
+  TriangleMesh mesh = ReadPly(input_path);
+  MR_LOG(INFO) << "Read " << input_path << ": " << mesh.NumVertices() << " vertices, "
+               << mesh.NumFaces() << " faces";
+  if (mesh.NumFaces() == 0) {
+    MR_THROW_INPUT << input_path << ": the mesh has no faces (a point cloud cannot be refined)";
+  }
+  if (dry_run) {
+    PrintSummary(workspace, source, mesh, input_path);
+    return 0;
+  }
+
+  Renderer renderer;
+  MR_LOG(INFO) << "Renderer: " << renderer.Description();
+
+  // Held-out views: photo-consistency before and after, through all views.
+  std::vector<int> holdout_views;
+  const WorkspaceViewSource all_views(workspace);
+  for (int i = 0; i < all_views.NumViews(); ++i) {
+    if (holdout.count(all_views.Name(i))) holdout_views.push_back(i);
+  }
+  double holdout_before = 0;
+  if (!holdout_views.empty()) {
+    holdout_before = PhotoConsistency(all_views, holdout_views, mesh.V, mesh.F, &renderer);
+  }
+
+  const RefineSummary summary = RefineMesh(source, refine, &mesh, &renderer);
+  WritePly(output_path, mesh);
+  MR_LOG(INFO) << "Wrote " << output_path;
+  std::cout << summary.FullReport();
+  if (!holdout_views.empty()) {
+    const double after = PhotoConsistency(all_views, holdout_views, mesh.V, mesh.F, &renderer);
+    std::printf("Held-out photo-consistency (mean ZNCC, %zu views): %.4f -> %.4f\n",
+                holdout_views.size(), holdout_before, after);
+  }
+  return 0;
+}
+
+}  // namespace
+}  // namespace mr
+
+int main(int argc, char** argv) {
+  try {
+    return mr::Run(argc, argv);
+  } catch (const mr::InputError& e) {
+    std::fprintf(stderr, "ERROR: %s\n", e.what());
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "ERROR (internal): %s\n", e.what());
+  }
+  return 1;
+}

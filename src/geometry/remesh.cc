@@ -1,0 +1,429 @@
+// The CGAL half of remesh.h: decimation, sqrt(3) subdivision, isotropic
+// remeshing and self-intersections. CGAL types stay in this file: (V, F) is
+// converted to a CGAL::Surface_mesh (Epick kernel) at entry and back at exit.
+
+#include "geometry/remesh.h"
+
+#include <algorithm>
+#include <cmath>
+#include <iterator>
+#include <sstream>
+#include <utility>
+#include <vector>
+
+#include <CGAL/Exact_predicates_inexact_constructions_kernel.h>
+#include <CGAL/Surface_mesh.h>
+#include <CGAL/exceptions.h>
+#include <CGAL/tags.h>
+
+#include <CGAL/Polygon_mesh_processing/detect_features.h>
+#include <CGAL/Polygon_mesh_processing/polygon_soup_to_polygon_mesh.h>
+#include <CGAL/Polygon_mesh_processing/remesh.h>
+#include <CGAL/Polygon_mesh_processing/repair_self_intersections.h>
+#include <CGAL/Polygon_mesh_processing/self_intersections.h>
+#include <CGAL/Surface_mesh_simplification/Policies/Edge_collapse/Bounded_normal_change_filter.h>
+#include <CGAL/Surface_mesh_simplification/Policies/Edge_collapse/GarlandHeckbert_plane_policies.h>
+#include <CGAL/Surface_mesh_simplification/Policies/Edge_collapse/LindstromTurk_cost.h>
+#include <CGAL/Surface_mesh_simplification/Policies/Edge_collapse/LindstromTurk_placement.h>
+#include <CGAL/Surface_mesh_simplification/edge_collapse.h>
+#include <CGAL/subdivision_method_3.h>
+
+#include "geometry/mesh.h"
+#include "util/error.h"
+#include "util/logging.h"
+
+namespace mr {
+namespace {
+
+using Kernel = CGAL::Exact_predicates_inexact_constructions_kernel;
+using Point = Kernel::Point_3;
+using Mesh = CGAL::Surface_mesh<Point>;
+namespace PMP = CGAL::Polygon_mesh_processing;
+namespace SMS = CGAL::Surface_mesh_simplification;
+
+// (V, F) -> Surface_mesh. Vertex i becomes vertex index i and face f face
+// index f (fresh mesh, sequential insertion). Throws InputError when (V, F)
+// is not an oriented 2-manifold.
+Mesh ToCgal(const Eigen::MatrixXd& V, const Eigen::MatrixXi& F, const char* what) {
+  std::vector<Point> points(V.rows());
+  for (int v = 0; v < V.rows(); ++v) points[v] = Point(V(v, 0), V(v, 1), V(v, 2));
+  std::vector<std::array<int, 3>> polygons(F.rows());
+  for (int f = 0; f < F.rows(); ++f) polygons[f] = {F(f, 0), F(f, 1), F(f, 2)};
+  if (!PMP::is_polygon_soup_a_polygon_mesh(polygons)) {
+    MR_THROW_INPUT << what
+                   << ": the mesh is not an oriented 2-manifold (non-manifold edge or vertex, "
+                      "or inconsistent orientation); run CleanMesh first";
+  }
+  Mesh mesh;
+  mesh.reserve(V.rows(), 3 * F.rows() / 2 + F.rows(), F.rows());
+  PMP::polygon_soup_to_polygon_mesh(points, polygons, mesh);
+  MR_CHECK_EQ(static_cast<long>(mesh.number_of_faces()), static_cast<long>(F.rows()));
+  return mesh;
+}
+
+// Surface_mesh -> (V, F), dropping removed elements.
+void FromCgal(const Mesh& mesh, Eigen::MatrixXd* V, Eigen::MatrixXi* F) {
+  std::vector<int> index(mesh.num_vertices(), -1);
+  V->resize(mesh.number_of_vertices(), 3);
+  int n = 0;
+  for (Mesh::Vertex_index v : mesh.vertices()) {
+    const Point& p = mesh.point(v);
+    V->row(n) << p.x(), p.y(), p.z();
+    index[v.idx()] = n++;
+  }
+  F->resize(mesh.number_of_faces(), 3);
+  int m = 0;
+  for (Mesh::Face_index f : mesh.faces()) {
+    int k = 0;
+    for (Mesh::Vertex_index v : CGAL::vertices_around_face(mesh.halfedge(f), mesh)) {
+      MR_CHECK_LT(k, 3) << "non-triangular face in CGAL output";
+      (*F)(m, k++) = index[v.idx()];
+    }
+    MR_CHECK_EQ(k, 3);
+    ++m;
+  }
+}
+
+// Stops when the mesh has at most `target` faces.
+struct FaceCountStop {
+  const Mesh* mesh;
+  std::size_t target;
+  template <typename FT, typename Profile>
+  bool operator()(const FT&, const Profile&, std::size_t, std::size_t) const {
+    return mesh->number_of_faces() <= target;
+  }
+};
+
+template <typename Cost, typename Placement>
+int CollapseEdges(Mesh* mesh, std::size_t target, const Cost& cost, const Placement& placement,
+                  bool bounded_normal_change) {
+  const FaceCountStop stop{mesh, target};
+  if (bounded_normal_change) {
+    const SMS::Bounded_normal_change_filter<> filter;
+    return SMS::edge_collapse(
+        *mesh, stop, CGAL::parameters::get_cost(cost).get_placement(placement).filter(filter));
+  }
+  return SMS::edge_collapse(*mesh, stop,
+                            CGAL::parameters::get_cost(cost).get_placement(placement));
+}
+
+// Runs a CGAL call; a CGAL precondition/assertion failure (almost always
+// caused by degenerate input) becomes an InputError with context.
+template <typename Fn>
+void RunCgal(const char* what, Fn&& fn) {
+  try {
+    fn();
+  } catch (const CGAL::Failure_exception& e) {
+    MR_THROW_INPUT << what << ": CGAL failed (" << e.what()
+                   << "); the mesh may be degenerate, run CleanMesh first";
+  }
+}
+
+}  // namespace
+
+// ---------------------------------------------------------------------------
+
+bool DecimateOptions::Check() const {
+  if (policy != "garland_heckbert" && policy != "lindstrom_turk") {
+    MR_THROW_INPUT << "DecimateOptions::policy = " << policy
+                   << ". Violated constraint: policy in {garland_heckbert, lindstrom_turk}";
+  }
+  return true;
+}
+
+std::string DecimateSummary::BriefReport() const {
+  std::ostringstream s;
+  s << policy << ": faces " << initial_faces << " -> " << final_faces << ", vertices "
+    << initial_vertices << " -> " << final_vertices << ", " << collapsed_edges
+    << " edges collapsed in " << seconds << " s"
+    << (target_not_reached ? " (target NOT reached: collapses blocked)" : "");
+  return s.str();
+}
+
+DecimateSummary Decimate(Eigen::MatrixXd* V, Eigen::MatrixXi* F, int target_faces,
+                         const DecimateOptions& options) {
+  MR_CHECK(V != nullptr && F != nullptr);
+  options.Check();
+  if (target_faces < 1) {
+    MR_THROW_INPUT << "Decimate: target_faces = " << target_faces
+                   << ". Violated constraint: target_faces >= 1";
+  }
+  CheckMeshInput(*V, *F, "Decimate");
+  const double t0 = ElapsedSeconds();
+  DecimateSummary summary;
+  summary.policy = options.policy;
+  summary.initial_vertices = summary.final_vertices = V->rows();
+  summary.initial_faces = summary.final_faces = F->rows();
+  if (F->rows() <= target_faces) {
+    MR_LOG(INFO) << "Decimate: " << F->rows() << " faces <= target " << target_faces
+                 << ", nothing to do";
+    return summary;
+  }
+  Mesh mesh = ToCgal(*V, *F, "Decimate");
+  RunCgal("Decimate", [&] {
+    if (options.policy == "garland_heckbert") {
+      const SMS::GarlandHeckbert_plane_policies<Mesh, Kernel> gh(mesh);
+      summary.collapsed_edges = CollapseEdges(&mesh, target_faces, gh.get_cost(),
+                                              gh.get_placement(), options.bounded_normal_change);
+    } else {
+      summary.collapsed_edges =
+          CollapseEdges(&mesh, target_faces, SMS::LindstromTurk_cost<Mesh>(),
+                        SMS::LindstromTurk_placement<Mesh>(), options.bounded_normal_change);
+    }
+  });
+  mesh.collect_garbage();
+  FromCgal(mesh, V, F);
+  summary.final_vertices = V->rows();
+  summary.final_faces = F->rows();
+  summary.target_not_reached = F->rows() > target_faces;
+  summary.seconds = ElapsedSeconds() - t0;
+  MR_LOG(INFO) << "Decimate: " << summary.BriefReport();
+  if (summary.target_not_reached) {
+    MR_LOG(WARNING) << "Decimate: stopped at " << summary.final_faces << " faces (target "
+                    << target_faces << "): no admissible collapse left";
+  }
+  return summary;
+}
+
+// ---------------------------------------------------------------------------
+
+SubdivisionSummary SubdivideSqrt3(Eigen::MatrixXd* V, Eigen::MatrixXi* F) {
+  MR_CHECK(V != nullptr && F != nullptr);
+  CheckMeshInput(*V, *F, "SubdivideSqrt3");
+  const double t0 = ElapsedSeconds();
+  SubdivisionSummary summary;
+  summary.initial_vertices = summary.final_vertices = V->rows();
+  summary.initial_faces = summary.final_faces = F->rows();
+  if (F->rows() == 0) return summary;
+  Mesh mesh = ToCgal(*V, *F, "SubdivideSqrt3");
+  RunCgal("SubdivideSqrt3", [&] {
+    CGAL::Subdivision_method_3::Sqrt3_subdivision(mesh,
+                                                  CGAL::parameters::number_of_iterations(1));
+  });
+  FromCgal(mesh, V, F);
+  summary.final_vertices = V->rows();
+  summary.final_faces = F->rows();
+  summary.seconds = ElapsedSeconds() - t0;
+  MR_LOG(INFO) << "SubdivideSqrt3: " << summary.BriefReport();
+  return summary;
+}
+
+// ---------------------------------------------------------------------------
+
+bool IsotropicRemeshOptions::Check() const {
+  if (iterations < 1 || iterations > 100) {
+    MR_THROW_INPUT << "IsotropicRemeshOptions::iterations = " << iterations
+                   << ". Violated constraint: 1 <= iterations <= 100";
+  }
+  if (relaxation_steps < 0 || relaxation_steps > 100) {
+    MR_THROW_INPUT << "IsotropicRemeshOptions::relaxation_steps = " << relaxation_steps
+                   << ". Violated constraint: 0 <= relaxation_steps <= 100";
+  }
+  if (!(sharp_angle_deg > 0 && sharp_angle_deg < 180)) {
+    MR_THROW_INPUT << "IsotropicRemeshOptions::sharp_angle_deg = " << sharp_angle_deg
+                   << ". Violated constraint: 0 < sharp_angle_deg < 180";
+  }
+  return true;
+}
+
+std::string IsotropicRemeshSummary::BriefReport() const {
+  std::ostringstream s;
+  s << "target edge " << target_edge_length << ": faces " << initial_faces << " -> "
+    << final_faces << ", vertices " << initial_vertices << " -> " << final_vertices
+    << ", mean edge " << initial_mean_edge_length << " -> " << final_mean_edge_length << ", "
+    << protected_edges << " protected edges, " << seconds << " s";
+  return s.str();
+}
+
+IsotropicRemeshSummary IsotropicRemesh(Eigen::MatrixXd* V, Eigen::MatrixXi* F,
+                                       double target_edge_length,
+                                       const IsotropicRemeshOptions& options) {
+  MR_CHECK(V != nullptr && F != nullptr);
+  options.Check();
+  if (!(target_edge_length > 0) || !std::isfinite(target_edge_length)) {
+    MR_THROW_INPUT << "IsotropicRemesh: target_edge_length = " << target_edge_length
+                   << ". Violated constraint: target_edge_length > 0 (finite)";
+  }
+  CheckMeshInput(*V, *F, "IsotropicRemesh");
+  const double t0 = ElapsedSeconds();
+  IsotropicRemeshSummary summary;
+  summary.target_edge_length = target_edge_length;
+  summary.initial_vertices = summary.final_vertices = V->rows();
+  summary.initial_faces = summary.final_faces = F->rows();
+  summary.initial_mean_edge_length = summary.final_mean_edge_length = MeanEdgeLength(*V, *F);
+  if (F->rows() == 0) return summary;
+  Mesh mesh = ToCgal(*V, *F, "IsotropicRemesh");
+  RunCgal("IsotropicRemesh", [&] {
+    auto constrained = mesh.add_property_map<Mesh::Edge_index, bool>("e:mr_constrained", false).first;
+    if (options.protect_border) {
+      for (Mesh::Edge_index e : mesh.edges()) {
+        if (mesh.is_border(e)) constrained[e] = true;
+      }
+    }
+    if (options.protect_sharp_edges) {
+      auto sharp = mesh.add_property_map<Mesh::Edge_index, bool>("e:mr_sharp", false).first;
+      PMP::detect_sharp_edges(mesh, options.sharp_angle_deg, sharp);
+      for (Mesh::Edge_index e : mesh.edges()) {
+        if (sharp[e]) constrained[e] = true;
+      }
+      mesh.remove_property_map(sharp);
+    }
+    std::vector<Mesh::Edge_index> protected_edges;
+    for (Mesh::Edge_index e : mesh.edges()) {
+      if (constrained[e]) protected_edges.push_back(e);
+    }
+    const bool protect = !protected_edges.empty();
+    if (protect) {
+      // CGAL can only protect edges <= 4/3 of the target: split them first
+      // (the pieces stay constrained).
+      PMP::split_long_edges(protected_edges, target_edge_length, mesh,
+                            CGAL::parameters::edge_is_constrained_map(constrained));
+      summary.protected_edges = 0;
+      for (Mesh::Edge_index e : mesh.edges()) summary.protected_edges += constrained[e] ? 1 : 0;
+    }
+    PMP::isotropic_remeshing(faces(mesh), target_edge_length, mesh,
+                             CGAL::parameters::number_of_iterations(options.iterations)
+                                 .number_of_relaxation_steps(options.relaxation_steps)
+                                 .protect_constraints(protect)
+                                 .edge_is_constrained_map(constrained));
+    mesh.remove_property_map(constrained);
+  });
+  mesh.collect_garbage();
+  FromCgal(mesh, V, F);
+  summary.final_vertices = V->rows();
+  summary.final_faces = F->rows();
+  summary.final_mean_edge_length = MeanEdgeLength(*V, *F);
+  summary.seconds = ElapsedSeconds() - t0;
+  MR_LOG(INFO) << "IsotropicRemesh: " << summary.BriefReport();
+  return summary;
+}
+
+// ---------------------------------------------------------------------------
+
+std::string SelfIntersectionReport::BriefReport() const {
+  std::ostringstream s;
+  s << intersecting_pairs << " intersecting face pairs (" << intersecting_faces << " faces), "
+    << (parallel ? "parallel" : "sequential") << ", " << seconds << " s";
+  return s.str();
+}
+
+SelfIntersectionReport CountSelfIntersections(const Eigen::MatrixXd& V, const Eigen::MatrixXi& F,
+                                              bool keep_pairs) {
+  CheckMeshInput(V, F, "CountSelfIntersections");
+  const double t0 = ElapsedSeconds();
+  SelfIntersectionReport report;
+  report.parallel = std::is_same<CGAL::Parallel_if_available_tag, CGAL::Parallel_tag>::value;
+  if (F.rows() == 0) return report;
+  const Mesh mesh = ToCgal(V, F, "CountSelfIntersections");
+  std::vector<std::pair<Mesh::Face_index, Mesh::Face_index>> pairs;
+  RunCgal("CountSelfIntersections", [&] {
+    PMP::self_intersections<CGAL::Parallel_if_available_tag>(faces(mesh), mesh,
+                                                             std::back_inserter(pairs));
+  });
+  report.intersecting_pairs = static_cast<long>(pairs.size());
+  std::vector<int> involved;
+  involved.reserve(2 * pairs.size());
+  for (const auto& p : pairs) {
+    // Fresh mesh: face index == row of F (see ToCgal).
+    const int a = static_cast<int>(p.first.idx()), b = static_cast<int>(p.second.idx());
+    involved.push_back(a);
+    involved.push_back(b);
+    if (keep_pairs) report.pairs.emplace_back(std::min(a, b), std::max(a, b));
+  }
+  std::sort(involved.begin(), involved.end());
+  report.intersecting_faces =
+      static_cast<int>(std::unique(involved.begin(), involved.end()) - involved.begin());
+  if (keep_pairs) std::sort(report.pairs.begin(), report.pairs.end());
+  report.seconds = ElapsedSeconds() - t0;
+  MR_LOG(VERBOSE) << "CountSelfIntersections: " << report.BriefReport();
+  return report;
+}
+
+bool RemoveSelfIntersectionsOptions::Check() const {
+  if (smoothing_rounds < 0 || smoothing_rounds > 1000) {
+    MR_THROW_INPUT << "RemoveSelfIntersectionsOptions::smoothing_rounds = " << smoothing_rounds
+                   << ". Violated constraint: 0 <= smoothing_rounds <= 1000";
+  }
+  if (!(smoothing_weight > 0 && smoothing_weight <= 1)) {
+    MR_THROW_INPUT << "RemoveSelfIntersectionsOptions::smoothing_weight = " << smoothing_weight
+                   << ". Violated constraint: 0 < smoothing_weight <= 1";
+  }
+  return true;
+}
+
+std::string RemoveSelfIntersectionsSummary::BriefReport() const {
+  std::ostringstream s;
+  s << "intersecting pairs " << initial_pairs << " -> " << final_pairs << " (CGAL repair "
+    << (cgal_repair_used ? (cgal_repair_succeeded ? "succeeded" : "incomplete") : "not used")
+    << ", " << smoothing_rounds_done << " smoothing rounds) in " << seconds << " s";
+  return s.str();
+}
+
+RemoveSelfIntersectionsSummary RemoveSelfIntersections(
+    Eigen::MatrixXd* V, Eigen::MatrixXi* F, const RemoveSelfIntersectionsOptions& options) {
+  MR_CHECK(V != nullptr && F != nullptr);
+  options.Check();
+  const double t0 = ElapsedSeconds();
+  RemoveSelfIntersectionsSummary summary;
+  SelfIntersectionReport report = CountSelfIntersections(*V, *F, true);
+  summary.initial_pairs = summary.final_pairs = report.intersecting_pairs;
+  if (report.intersecting_pairs == 0) return summary;
+
+  if (options.use_cgal_repair) {
+    summary.cgal_repair_used = true;
+    Mesh mesh = ToCgal(*V, *F, "RemoveSelfIntersections");
+    try {
+      summary.cgal_repair_succeeded =
+          PMP::experimental::remove_self_intersections(mesh, CGAL::parameters::preserve_genus(true));
+      mesh.collect_garbage();
+      FromCgal(mesh, V, F);
+    } catch (const CGAL::Failure_exception& e) {
+      MR_LOG(WARNING) << "RemoveSelfIntersections: CGAL repair failed (" << e.what()
+                      << "); continuing with smoothing";
+    }
+    report = CountSelfIntersections(*V, *F, true);
+  }
+
+  // Fallback: umbrella smoothing of the intersecting faces' vertices and
+  // their one-ring, re-checked after every round.
+  for (int round = 0; round < options.smoothing_rounds && report.intersecting_pairs > 0; ++round) {
+    const std::vector<std::vector<int>> adjacency = VertexAdjacency(*F, V->rows());
+    std::vector<int> verts;
+    for (const auto& p : report.pairs) {
+      for (int f : {p.first, p.second}) {
+        for (int k = 0; k < 3; ++k) {
+          const int v = (*F)(f, k);
+          verts.push_back(v);
+          verts.insert(verts.end(), adjacency[v].begin(), adjacency[v].end());
+        }
+      }
+    }
+    std::sort(verts.begin(), verts.end());
+    verts.erase(std::unique(verts.begin(), verts.end()), verts.end());
+    Eigen::MatrixXd target(verts.size(), 3);
+    for (size_t i = 0; i < verts.size(); ++i) {
+      Eigen::RowVector3d avg = Eigen::RowVector3d::Zero();
+      for (int w : adjacency[verts[i]]) avg += V->row(w);
+      const size_t n = adjacency[verts[i]].size();
+      target.row(i) = n > 0 ? Eigen::RowVector3d(avg / n) : Eigen::RowVector3d(V->row(verts[i]));
+    }
+    for (size_t i = 0; i < verts.size(); ++i) {
+      V->row(verts[i]) = (1 - options.smoothing_weight) * V->row(verts[i]) +
+                         options.smoothing_weight * target.row(i);
+    }
+    report = CountSelfIntersections(*V, *F, true);
+    summary.smoothing_rounds_done = round + 1;
+    MR_LOG(VERBOSE) << "RemoveSelfIntersections: smoothing round " << round + 1 << ": "
+                    << report.intersecting_pairs << " pairs remain";
+  }
+  summary.final_pairs = report.intersecting_pairs;
+  summary.seconds = ElapsedSeconds() - t0;
+  MR_LOG(INFO) << "RemoveSelfIntersections: " << summary.BriefReport();
+  if (summary.final_pairs > 0) {
+    MR_LOG(WARNING) << "RemoveSelfIntersections: " << summary.final_pairs
+                    << " intersecting face pairs remain";
+  }
+  return summary;
+}
+
+}  // namespace mr

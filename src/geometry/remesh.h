@@ -1,0 +1,261 @@
+#pragma once
+
+// Mesh maintenance for the coarse-to-fine refinement loop: decimation,
+// subdivision, isotropic remeshing, cleaning, self-intersection and
+// flipped-face repair. libigl-style interface over Eigen:
+//   V is #V by 3 (double), F is #F by 3 (int, counter-clockwise = outward).
+// CGAL (Surface_mesh, Epick kernel) is used inside remesh.cc only; it never
+// appears in this header. Functions that go through CGAL need an oriented
+// 2-manifold mesh (every edge in at most two faces, consistently oriented,
+// no pinched vertices): they throw mr::InputError otherwise, and CleanMesh()
+// produces such a mesh from most garbage. Every entry point throws
+// mr::InputError on malformed input (wrong column counts, indices out of
+// range, NaN/Inf positions); an empty mesh (no faces) passes through.
+//
+// Library: mr_remesh (links CGAL; keep it out of mr_geometry).
+
+#include <Eigen/Core>
+#include <string>
+#include <vector>
+
+namespace mr {
+
+// Throws mr::InputError when V/F are malformed: V not #V by 3, F not #F by 3,
+// an index outside [0, #V), or a non-finite (NaN/Inf) coordinate anywhere in V.
+// `what` prefixes the message (e.g. the function name).
+void CheckMeshInput(const Eigen::MatrixXd& V, const Eigen::MatrixXi& F, const std::string& what);
+
+// ---------------------------------------------------------------------------
+// Decimation (CGAL Surface_mesh_simplification edge collapse).
+
+struct DecimateOptions {
+  // Cost/placement policy: "garland_heckbert" (plane quadrics, Garland &
+  // Heckbert 1997; CGAL >= 5.5) or "lindstrom_turk" (Lindstrom & Turk 1998).
+  std::string policy = "garland_heckbert";
+  // Reject a collapse if any face of the resulting star turns its normal by
+  // 90 degrees or more (CGAL Bounded_normal_change_filter): prevents folds.
+  bool bounded_normal_change = true;
+
+  bool Check() const;
+};
+
+struct DecimateSummary {
+  int initial_vertices = 0, initial_faces = 0;
+  int final_vertices = 0, final_faces = 0;
+  int collapsed_edges = 0;
+  std::string policy;  // the policy actually used
+  double seconds = 0;
+  // True when the target was not reached (the filter/topology blocked collapses).
+  bool target_not_reached = false;
+  std::string BriefReport() const;
+};
+
+// Collapses edges until the mesh has at most `target_faces` faces (each
+// interior collapse removes 2 faces, so the result is target_faces or
+// target_faces - 1, unless collapses are blocked). target_faces >= 1;
+// a mesh already at or below the target is returned unchanged. In place.
+DecimateSummary Decimate(Eigen::MatrixXd* V, Eigen::MatrixXi* F, int target_faces,
+                         const DecimateOptions& options = DecimateOptions());
+
+// ---------------------------------------------------------------------------
+// Subdivision.
+
+struct SubdivisionSummary {
+  int initial_vertices = 0, initial_faces = 0;
+  int final_vertices = 0, final_faces = 0;
+  double seconds = 0;
+  std::string BriefReport() const;
+};
+
+// One step of Kobbelt's sqrt(3) subdivision (CGAL Subdivision_method_3):
+// a vertex per face, edge flips, and smoothing of the old vertices. #F
+// triples on a closed mesh. NOTE: it is an approximating scheme: the old
+// vertices MOVE (the surface shrinks slightly towards its limit surface), so
+// refinement that must keep the shape should use SubdivideMidpoint. Needs an
+// oriented 2-manifold. In place.
+SubdivisionSummary SubdivideSqrt3(Eigen::MatrixXd* V, Eigen::MatrixXi* F);
+
+// One step of linear 1-to-4 subdivision: a new vertex at the midpoint of
+// every unique edge, each face split into 4 (orientation kept). Old vertices
+// do not move, new ones lie on the old surface: the shape is exactly kept.
+// Works on any triangle soup (boundary and non-manifold edges included).
+// New vertices are appended after the old ones (old indices stay valid).
+// In place.
+SubdivisionSummary SubdivideMidpoint(Eigen::MatrixXd* V, Eigen::MatrixXi* F);
+
+// ---------------------------------------------------------------------------
+// Isotropic remeshing (CGAL Polygon_mesh_processing::isotropic_remeshing:
+// split long / collapse short edges, flip to valence 6, tangential relaxation).
+
+struct IsotropicRemeshOptions {
+  // Number of split/collapse/flip/relax rounds, in [1, 100].
+  int iterations = 3;
+  // Tangential relaxation steps per round, in [0, 100].
+  int relaxation_steps = 1;
+  // Keep border edges fixed (they are first split to <= 4/3 of the target
+  // length so that CGAL can protect them).
+  bool protect_border = true;
+  // Keep sharp edges (dihedral angle above sharp_angle_deg) fixed likewise.
+  bool protect_sharp_edges = false;
+  // Dihedral angle (degrees, in (0, 180)) above which an edge is sharp.
+  double sharp_angle_deg = 60.0;
+
+  bool Check() const;
+};
+
+struct IsotropicRemeshSummary {
+  int initial_vertices = 0, initial_faces = 0;
+  int final_vertices = 0, final_faces = 0;
+  double target_edge_length = 0;
+  double initial_mean_edge_length = 0, final_mean_edge_length = 0;
+  int protected_edges = 0;  // border + sharp edges kept
+  double seconds = 0;
+  std::string BriefReport() const;
+};
+
+// Remeshes towards edges of length `target_edge_length` (> 0, in the units of
+// V). Needs an oriented 2-manifold. In place. (CGAL 5.5 has no adaptive
+// sizing field; an adaptive variant is not provided.)
+IsotropicRemeshSummary IsotropicRemesh(Eigen::MatrixXd* V, Eigen::MatrixXi* F,
+                                       double target_edge_length,
+                                       const IsotropicRemeshOptions& options =
+                                           IsotropicRemeshOptions());
+
+// ---------------------------------------------------------------------------
+// Cleaning (Eigen only; works on arbitrary triangle soups).
+
+struct CleanMeshOptions {
+  // A face is degenerate (zero area) when 2*area <= tolerance * (longest
+  // edge)^2; in [0, 1e-3]. Such faces are removed by flipping their longest
+  // edge into the neighbour (keeps closed meshes closed) or, if impossible,
+  // by deleting them.
+  double degenerate_area_tolerance = 1e-12;
+  // Duplicate each non-manifold vertex once per face fan (and cut
+  // non-manifold edges, treated as fan separators), so that the result is a
+  // 2-manifold with boundary. If false, they are only counted.
+  bool fix_non_manifold = true;
+  // Orient every connected component consistently, keeping the orientation
+  // of the majority of its faces (Poisson meshes are outward).
+  bool orient = true;
+
+  bool Check() const;
+};
+
+struct CleanMeshReport {
+  int initial_vertices = 0, initial_faces = 0;
+  int final_vertices = 0, final_faces = 0;
+  int merged_duplicate_vertices = 0;   // exactly equal positions merged
+  int removed_repeated_index_faces = 0;  // faces using a vertex twice
+  int removed_duplicate_faces = 0;     // same vertex triple (any order)
+  int flipped_degenerate_faces = 0;    // zero-area faces removed by an edge flip
+  int removed_degenerate_faces = 0;    // zero-area faces deleted
+  int removed_unreferenced_vertices = 0;
+  int non_manifold_edges = 0;          // found (before fixing)
+  int non_manifold_vertices = 0;       // found (before fixing)
+  int split_vertices = 0;              // copies added by the non-manifold fix
+  int remaining_non_manifold_edges = 0;    // in the result
+  int remaining_non_manifold_vertices = 0; // in the result
+  int reoriented_faces = 0;            // faces whose orientation was reversed
+  int non_orientable_components = 0;   // components that could not be oriented (left as input)
+  int inconsistent_edges = 0;          // manifold edges with inconsistent orientation, in the result
+  int connected_components = 0;
+  int boundary_edges = 0;              // in the result
+  double seconds = 0;
+  // True when the result is an oriented 2-manifold (usable by the CGAL functions).
+  bool IsCleanManifold() const;
+  std::string BriefReport() const;
+};
+
+// Cleans (V, F) in place. Throws InputError on malformed input (see
+// CheckMeshInput), never crashes on degenerate geometry.
+CleanMeshReport CleanMesh(Eigen::MatrixXd* V, Eigen::MatrixXi* F,
+                          const CleanMeshOptions& options = CleanMeshOptions());
+
+// ---------------------------------------------------------------------------
+// Self-intersections.
+
+struct SelfIntersectionReport {
+  long intersecting_pairs = 0;       // pairs of faces that intersect (not adjacent-legal)
+  int intersecting_faces = 0;        // distinct faces involved
+  std::vector<std::pair<int, int>> pairs;  // face index pairs (if requested)
+  bool parallel = false;             // computed with TBB
+  double seconds = 0;
+  std::string BriefReport() const;
+};
+
+// Counts self-intersecting face pairs (CGAL PMP::self_intersections, uses
+// TBB when CGAL was built/linked with it). Needs an oriented 2-manifold.
+// `keep_pairs`: also return the pairs.
+SelfIntersectionReport CountSelfIntersections(const Eigen::MatrixXd& V, const Eigen::MatrixXi& F,
+                                              bool keep_pairs = false);
+
+struct RemoveSelfIntersectionsOptions {
+  // Try CGAL's PMP::experimental::remove_self_intersections first (it may
+  // remove faces and fill holes: the vertex/face count can change).
+  bool use_cgal_repair = true;
+  // Then, for what remains, Laplacian smoothing of the vertices of the
+  // intersecting faces and of their one-ring: rounds in [0, 1000].
+  int smoothing_rounds = 20;
+  // Weight of the neighbours' average in each smoothing step, in (0, 1].
+  double smoothing_weight = 0.5;
+
+  bool Check() const;
+};
+
+struct RemoveSelfIntersectionsSummary {
+  long initial_pairs = 0;
+  long final_pairs = 0;  // what remains (0 = fixed)
+  bool cgal_repair_used = false;
+  bool cgal_repair_succeeded = false;
+  int smoothing_rounds_done = 0;
+  double seconds = 0;
+  std::string BriefReport() const;
+};
+
+// Best effort; reports what remains. In place.
+RemoveSelfIntersectionsSummary RemoveSelfIntersections(
+    Eigen::MatrixXd* V, Eigen::MatrixXi* F,
+    const RemoveSelfIntersectionsOptions& options = RemoveSelfIntersectionsOptions());
+
+// ---------------------------------------------------------------------------
+// Flipped faces (Eigen only): faces whose normal turned by more than
+// `max_angle_deg` (default 90 degrees, i.e. n_before . n_after < 0) between
+// two vertex sets over the same F. Degenerate faces (zero normal before or
+// after) are not counted as flipped.
+
+std::vector<int> FlippedFaces(const Eigen::MatrixXd& V_before, const Eigen::MatrixXd& V_after,
+                              const Eigen::MatrixXi& F, double max_angle_deg = 90.0);
+int CountFlippedFaces(const Eigen::MatrixXd& V_before, const Eigen::MatrixXd& V_after,
+                      const Eigen::MatrixXi& F, double max_angle_deg = 90.0);
+
+struct FixFlippedFacesOptions {
+  // Flip threshold (degrees) in (0, 180].
+  double max_angle_deg = 90.0;
+  // Phase 1: rounds of umbrella smoothing of the vertices of flipped faces
+  // (towards their one-ring average), in [0, 1000].
+  int smoothing_rounds = 10;
+  // Weight of the one-ring average per smoothing round, in (0, 1].
+  double smoothing_weight = 0.5;
+
+  bool Check() const;
+};
+
+struct FixFlippedFacesSummary {
+  int initial_flipped = 0;
+  int final_flipped = 0;  // always 0 (phase 2 guarantees it)
+  int smoothing_rounds_done = 0;
+  int reset_vertices = 0;  // vertices moved back to V_before in phase 2
+  std::string BriefReport() const;
+};
+
+// Repairs *V_after in place so that no face is flipped relative to
+// V_before. Phase 1: smoothing rounds (above). Phase 2: the vertices of the
+// faces still flipped are reset to their V_before positions, repeated until
+// none remains; terminates because a face whose three vertices are all reset
+// equals its V_before self. V_before and *V_after must have the same shape.
+FixFlippedFacesSummary FixFlippedFaces(const Eigen::MatrixXd& V_before, const Eigen::MatrixXi& F,
+                                       Eigen::MatrixXd* V_after,
+                                       const FixFlippedFacesOptions& options =
+                                           FixFlippedFacesOptions());
+
+}  // namespace mr

@@ -1,0 +1,574 @@
+#include "geometry/remesh.h"
+
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdlib>
+#include <limits>
+
+#include "geometry/mesh.h"
+#include "util/error.h"
+
+namespace mr {
+namespace {
+
+// Unit icosphere: icosahedron (20 faces, outward CCW) with `levels` midpoint
+// subdivisions projected to the sphere: 20 * 4^levels faces.
+void Icosphere(int levels, Eigen::MatrixXd* V, Eigen::MatrixXi* F) {
+  const double t = (1.0 + std::sqrt(5.0)) / 2.0;
+  V->resize(12, 3);
+  *V << -1, t, 0, 1, t, 0, -1, -t, 0, 1, -t, 0, 0, -1, t, 0, 1, t, 0, -1, -t, 0, 1, -t, t, 0,
+      -1, t, 0, 1, -t, 0, -1, -t, 0, 1;
+  F->resize(20, 3);
+  *F << 0, 11, 5, 0, 5, 1, 0, 1, 7, 0, 7, 10, 0, 10, 11, 1, 5, 9, 5, 11, 4, 11, 10, 2, 10, 7, 6,
+      7, 1, 8, 3, 9, 4, 3, 4, 2, 3, 2, 6, 3, 6, 8, 3, 8, 9, 4, 9, 5, 2, 4, 11, 6, 2, 10, 8, 6, 7,
+      9, 8, 1;
+  V->rowwise().normalize();
+  for (int l = 0; l < levels; ++l) {
+    SubdivideMidpoint(V, F);
+    V->rowwise().normalize();
+  }
+}
+
+double MaxRadiusError(const Eigen::MatrixXd& V) {
+  return (V.rowwise().norm().array() - 1.0).abs().maxCoeff();
+}
+
+// Max distance of face centroids to the unit sphere (the mesh-to-sphere side).
+double MaxCentroidRadiusError(const Eigen::MatrixXd& V, const Eigen::MatrixXi& F) {
+  double e = 0;
+  for (int f = 0; f < F.rows(); ++f) {
+    const Eigen::Vector3d c = (V.row(F(f, 0)) + V.row(F(f, 1)) + V.row(F(f, 2))) / 3.0;
+    e = std::max(e, std::abs(c.norm() - 1.0));
+  }
+  return e;
+}
+
+bool IsClosedManifold(const Eigen::MatrixXd& V, const Eigen::MatrixXi& F) {
+  const EdgeTopology topo = ComputeEdgeTopology(F, V.rows());
+  return topo.NumBoundaryEdges() == 0 && topo.NumNonManifoldEdges() == 0;
+}
+
+TEST(RemeshOptions, DefaultsAreValid) {
+  EXPECT_TRUE(DecimateOptions().Check());
+  EXPECT_TRUE(IsotropicRemeshOptions().Check());
+  EXPECT_TRUE(CleanMeshOptions().Check());
+  EXPECT_TRUE(RemoveSelfIntersectionsOptions().Check());
+  EXPECT_TRUE(FixFlippedFacesOptions().Check());
+}
+
+TEST(RemeshOptions, InvalidValuesThrow) {
+  DecimateOptions d;
+  d.policy = "edge_length";
+  EXPECT_THROW(d.Check(), InputError);
+  IsotropicRemeshOptions r;
+  r.iterations = 0;
+  EXPECT_THROW(r.Check(), InputError);
+  CleanMeshOptions c;
+  c.degenerate_area_tolerance = -1;
+  EXPECT_THROW(c.Check(), InputError);
+  RemoveSelfIntersectionsOptions s;
+  s.smoothing_weight = 0;
+  EXPECT_THROW(s.Check(), InputError);
+  FixFlippedFacesOptions x;
+  x.max_angle_deg = 0;
+  EXPECT_THROW(x.Check(), InputError);
+}
+
+TEST(Decimate, GarlandHeckbertReachesTargetAndKeepsSphere) {
+  Eigen::MatrixXd V;
+  Eigen::MatrixXi F;
+  Icosphere(5, &V, &F);  // 20480 faces
+  const int target = 2000;
+  const DecimateSummary s = Decimate(&V, &F, target);
+  EXPECT_EQ(s.policy, "garland_heckbert");
+  EXPECT_EQ(s.initial_faces, 20480);
+  EXPECT_NEAR(F.rows(), target, 0.05 * target);
+  EXPECT_EQ(s.final_faces, F.rows());
+  EXPECT_TRUE(IsClosedManifold(V, F));
+  // Edges of ~0.1: chord sagitta ~1e-3. 1% of the radius is a generous bound
+  // that a wrong placement (e.g. collapsing to a far vertex) breaks.
+  EXPECT_LT(MaxRadiusError(V), 0.01);
+  EXPECT_LT(MaxCentroidRadiusError(V, F), 0.01);
+  // Still outward: every face normal points away from the centre.
+  const Eigen::MatrixXd N = FaceNormals(V, F);
+  for (int f = 0; f < F.rows(); ++f) {
+    const Eigen::Vector3d c = (V.row(F(f, 0)) + V.row(F(f, 1)) + V.row(F(f, 2))) / 3.0;
+    ASSERT_GT(N.row(f).dot(c.normalized()), 0.5) << "face " << f;
+  }
+}
+
+TEST(Decimate, LindstromTurk) {
+  Eigen::MatrixXd V;
+  Eigen::MatrixXi F;
+  Icosphere(4, &V, &F);  // 5120 faces
+  DecimateOptions options;
+  options.policy = "lindstrom_turk";
+  Decimate(&V, &F, 1000, options);
+  EXPECT_NEAR(F.rows(), 1000, 50);
+  EXPECT_TRUE(IsClosedManifold(V, F));
+  EXPECT_LT(MaxRadiusError(V), 0.02);
+}
+
+TEST(Decimate, BelowTargetIsUnchanged) {
+  Eigen::MatrixXd V;
+  Eigen::MatrixXi F;
+  Icosphere(1, &V, &F);
+  const Eigen::MatrixXd V0 = V;
+  const Eigen::MatrixXi F0 = F;
+  Decimate(&V, &F, 1000);
+  EXPECT_EQ(V, V0);
+  EXPECT_EQ(F, F0);
+  EXPECT_THROW(Decimate(&V, &F, 0), InputError);
+}
+
+TEST(SubdivideSqrt3, TriplesFacesAndStaysClosed) {
+  Eigen::MatrixXd V;
+  Eigen::MatrixXi F;
+  Icosphere(2, &V, &F);  // 320 faces, 162 vertices
+  const SubdivisionSummary s = SubdivideSqrt3(&V, &F);
+  EXPECT_EQ(F.rows(), 3 * 320);
+  EXPECT_EQ(V.rows(), 162 + 320);
+  EXPECT_EQ(s.final_faces, 960);
+  EXPECT_TRUE(IsClosedManifold(V, F));
+  // Smoothing: points move, but only a little on a fine sphere, and inward.
+  EXPECT_LT(MaxRadiusError(V), 0.05);
+  EXPECT_GT(VertexNormals(V, F).row(0).dot(V.row(0).normalized()), 0.99);
+}
+
+TEST(SubdivideMidpoint, QuadruplesFacesWithoutMovingVertices) {
+  Eigen::MatrixXd V;
+  Eigen::MatrixXi F;
+  Icosphere(2, &V, &F);
+  const Eigen::MatrixXd V0 = V;
+  const Eigen::MatrixXi F0 = F;
+  const double area0 = FaceAreas(V0, F0).sum();
+  SubdivideMidpoint(&V, &F);
+  EXPECT_EQ(F.rows(), 4 * F0.rows());
+  EXPECT_EQ(V.rows(), V0.rows() + ComputeEdgeTopology(F0, V0.rows()).E.rows());
+  EXPECT_EQ(V.topRows(V0.rows()), V0);  // old vertices do not move
+  EXPECT_NEAR(FaceAreas(V, F).sum(), area0, 1e-12 * area0);  // same surface
+  EXPECT_TRUE(IsClosedManifold(V, F));
+  // Orientation kept: each child normal equals its parent's.
+  const Eigen::MatrixXd N0 = FaceNormals(V0, F0), N = FaceNormals(V, F);
+  for (int f = 0; f < F.rows(); ++f) ASSERT_GT(N.row(f).dot(N0.row(f / 4)), 1 - 1e-9);
+}
+
+TEST(SubdivideMidpoint, OpenMesh) {
+  Eigen::MatrixXd V(3, 3);
+  V << 0, 0, 0, 1, 0, 0, 0, 1, 0;
+  Eigen::MatrixXi F(1, 3);
+  F << 0, 1, 2;
+  SubdivideMidpoint(&V, &F);
+  EXPECT_EQ(F.rows(), 4);
+  EXPECT_EQ(V.rows(), 6);
+  EXPECT_NEAR(FaceAreas(V, F).sum(), 0.5, 1e-15);
+  EXPECT_EQ(ComputeEdgeTopology(F, V.rows()).NumBoundaryEdges(), 6);
+}
+
+TEST(IsotropicRemesh, SphereReachesTargetEdgeLength) {
+  Eigen::MatrixXd V;
+  Eigen::MatrixXi F;
+  Icosphere(4, &V, &F);  // edges ~0.05
+  const double target = 0.12;
+  const IsotropicRemeshSummary s = IsotropicRemesh(&V, &F, target);
+  const double mean = MeanEdgeLength(V, F);
+  EXPECT_NEAR(mean, target, 0.2 * target);
+  EXPECT_NEAR(s.final_mean_edge_length, mean, 1e-12);
+  // Equilateral triangles of side `target` tiling the sphere's area 4 pi.
+  const double expected_faces = 4 * M_PI / (std::sqrt(3.0) / 4 * target * target);
+  EXPECT_NEAR(F.rows(), expected_faces, 0.25 * expected_faces);
+  EXPECT_TRUE(IsClosedManifold(V, F));
+  EXPECT_LT(MaxRadiusError(V), 0.02);
+}
+
+TEST(IsotropicRemesh, ProtectedBorderStaysOnInputBorder) {
+  Eigen::MatrixXd V;
+  Eigen::MatrixXi F;
+  Icosphere(3, &V, &F);
+  // Keep the upper half: an open mesh.
+  Eigen::MatrixXi H(F.rows(), 3);
+  int n = 0;
+  for (int f = 0; f < F.rows(); ++f) {
+    if (V(F(f, 0), 2) + V(F(f, 1), 2) + V(F(f, 2), 2) > 0) H.row(n++) = F.row(f);
+  }
+  H.conservativeResize(n, 3);
+  F = H;
+  RemoveUnreferencedVertices(&V, &F);
+  const EdgeTopology topo0 = ComputeEdgeTopology(F, V.rows());
+  ASSERT_GT(topo0.NumBoundaryEdges(), 0);
+  std::vector<std::pair<Eigen::Vector3d, Eigen::Vector3d>> border;
+  for (int e = 0; e < topo0.E.rows(); ++e) {
+    if (topo0.edge_faces[e].size() == 1)
+      border.emplace_back(V.row(topo0.E(e, 0)), V.row(topo0.E(e, 1)));
+  }
+  IsotropicRemesh(&V, &F, 0.08);
+  const EdgeTopology topo = ComputeEdgeTopology(F, V.rows());
+  ASSERT_GT(topo.NumBoundaryEdges(), 0);
+  for (int e = 0; e < topo.E.rows(); ++e) {
+    if (topo.edge_faces[e].size() != 1) continue;
+    for (int j = 0; j < 2; ++j) {
+      const Eigen::Vector3d p = V.row(topo.E(e, j));
+      double best = std::numeric_limits<double>::infinity();
+      for (const auto& s : border) {
+        const Eigen::Vector3d d = s.second - s.first;
+        const double t = std::clamp((p - s.first).dot(d) / d.squaredNorm(), 0.0, 1.0);
+        best = std::min(best, (s.first + t * d - p).norm());
+      }
+      ASSERT_LT(best, 1e-9) << "border vertex left the input border";
+    }
+  }
+}
+
+TEST(IsotropicRemesh, InvalidTarget) {
+  Eigen::MatrixXd V;
+  Eigen::MatrixXi F;
+  Icosphere(1, &V, &F);
+  EXPECT_THROW(IsotropicRemesh(&V, &F, 0.0), InputError);
+  EXPECT_THROW(IsotropicRemesh(&V, &F, std::nan("")), InputError);
+}
+
+TEST(CleanMesh, CleanSphereIsUnchanged) {
+  Eigen::MatrixXd V;
+  Eigen::MatrixXi F;
+  Icosphere(2, &V, &F);
+  const Eigen::MatrixXd V0 = V;
+  const Eigen::MatrixXi F0 = F;
+  const CleanMeshReport r = CleanMesh(&V, &F);
+  EXPECT_EQ(V, V0);
+  EXPECT_EQ(F, F0);
+  EXPECT_TRUE(r.IsCleanManifold());
+  EXPECT_EQ(r.connected_components, 1);
+  EXPECT_EQ(r.boundary_edges, 0);
+}
+
+TEST(CleanMesh, RemovesInjectedDegeneraciesAndDuplicates) {
+  Eigen::MatrixXd V;
+  Eigen::MatrixXi F;
+  Icosphere(2, &V, &F);
+  const Eigen::MatrixXd V0 = V;
+  const Eigen::MatrixXi F0 = F;
+  const int nv = V.rows(), nf = F.rows();
+  // A duplicate of vertex F(0,0), used by face 0.
+  V.conservativeResize(nv + 2, 3);
+  V.row(nv) = V.row(F(0, 0));
+  F(0, 0) = nv;
+  // An unreferenced vertex.
+  V.row(nv + 1) << 5, 5, 5;
+  // A face using a vertex twice and a duplicate of face 3 (other orientation).
+  F.conservativeResize(nf + 2, 3);
+  F.row(nf) << 1, 1, 2;
+  F.row(nf + 1) << F(3, 0), F(3, 2), F(3, 1);
+  const CleanMeshReport r = CleanMesh(&V, &F);
+  EXPECT_EQ(r.merged_duplicate_vertices, 1);
+  EXPECT_EQ(r.removed_repeated_index_faces, 1);
+  EXPECT_EQ(r.removed_duplicate_faces, 1);
+  EXPECT_EQ(r.removed_unreferenced_vertices, 2);  // the merged copy and (5,5,5)
+  EXPECT_EQ(V, V0);  // vertex order kept
+  EXPECT_EQ(F, F0);
+  EXPECT_TRUE(r.IsCleanManifold());
+  EXPECT_TRUE(IsClosedManifold(V, F));
+  EXPECT_EQ(CountSelfIntersections(V, F).intersecting_pairs, 0);
+}
+
+TEST(CleanMesh, ZeroAreaCapIsFlippedAway) {
+  Eigen::MatrixXd V;
+  Eigen::MatrixXi F;
+  Icosphere(2, &V, &F);
+  const int nv = V.rows(), nf = F.rows();
+  // Split face 0 = (x, y, z) at b = midpoint(y, z) and add the cap (y, z, b):
+  // still closed, but the cap has zero area.
+  const int x = F(0, 0), y = F(0, 1), z = F(0, 2);
+  V.conservativeResize(nv + 1, 3);
+  V.row(nv) = 0.5 * (V.row(y) + V.row(z));
+  const int b = nv;
+  F.conservativeResize(nf + 2, 3);
+  F.row(0) << x, y, b;
+  F.row(nf) << x, b, z;
+  F.row(nf + 1) << y, z, b;
+  ASSERT_TRUE(IsClosedManifold(V, F));
+  ASSERT_EQ(FaceAreas(V, F).minCoeff() < 1e-12, true);
+  const CleanMeshReport r = CleanMesh(&V, &F);
+  EXPECT_EQ(r.flipped_degenerate_faces, 1);
+  EXPECT_EQ(r.removed_degenerate_faces, 0);
+  EXPECT_EQ(F.rows(), nf + 2);
+  EXPECT_TRUE(IsClosedManifold(V, F));
+  EXPECT_TRUE(r.IsCleanManifold());
+  EXPECT_GT(FaceAreas(V, F).minCoeff(), 1e-4);
+  // Orientation is still outward everywhere.
+  const Eigen::MatrixXd N = FaceNormals(V, F);
+  for (int f = 0; f < F.rows(); ++f) {
+    const Eigen::Vector3d c = (V.row(F(f, 0)) + V.row(F(f, 1)) + V.row(F(f, 2))) / 3.0;
+    ASSERT_GT(N.row(f).dot(c.normalized()), 0) << "face " << f;
+  }
+}
+
+TEST(CleanMesh, ReorientsMinorityFaces) {
+  Eigen::MatrixXd V;
+  Eigen::MatrixXi F;
+  Icosphere(2, &V, &F);
+  const Eigen::MatrixXi F0 = F;
+  for (int f : {3, 50, 51, 200}) std::swap(F(f, 1), F(f, 2));
+  const CleanMeshReport r = CleanMesh(&V, &F);
+  EXPECT_EQ(r.reoriented_faces, 4);
+  EXPECT_EQ(r.inconsistent_edges, 0);
+  EXPECT_EQ(F, F0);
+}
+
+TEST(CleanMesh, SplitsPinchedVertex) {
+  Eigen::MatrixXd A;
+  Eigen::MatrixXi FA;
+  Icosphere(1, &A, &FA);
+  // Two spheres touching at one vertex: B = A + 2 A(0), whose vertex 3
+  // (antipodal to vertex 0 on the icosahedron) lands on A's vertex 0.
+  Eigen::MatrixXd B = A.rowwise() + 2.0 * A.row(0);
+  B.row(3) = A.row(0);
+  const Eigen::MatrixXi FB = FA;
+  Eigen::MatrixXd V(A.rows() + B.rows(), 3);
+  V << A, B;
+  Eigen::MatrixXi F(FA.rows() + FB.rows(), 3);
+  F << FA, (FB.array() + A.rows()).matrix();
+  const CleanMeshReport r = CleanMesh(&V, &F);
+  EXPECT_EQ(r.merged_duplicate_vertices, 1);
+  EXPECT_EQ(r.non_manifold_vertices, 1);
+  EXPECT_EQ(r.split_vertices, 1);
+  EXPECT_EQ(r.remaining_non_manifold_vertices, 0);
+  EXPECT_EQ(r.connected_components, 2);
+  EXPECT_TRUE(r.IsCleanManifold());
+  EXPECT_EQ(V.rows(), 2 * A.rows());
+  EXPECT_TRUE(IsClosedManifold(V, F));
+}
+
+TEST(CleanMesh, GarbageThrowsInputError) {
+  Eigen::MatrixXd V;
+  Eigen::MatrixXi F;
+  Icosphere(1, &V, &F);
+  Eigen::MatrixXd Vn = V;
+  Vn(5, 1) = std::numeric_limits<double>::quiet_NaN();
+  EXPECT_THROW(CleanMesh(&Vn, &F), InputError);
+  Eigen::MatrixXi Fb = F;
+  Fb(2, 2) = V.rows();
+  EXPECT_THROW(CleanMesh(&V, &Fb), InputError);
+  Fb(2, 2) = -1;
+  EXPECT_THROW(CleanMesh(&V, &Fb), InputError);
+  Eigen::MatrixXi F4(1, 4);
+  F4 << 0, 1, 2, 3;
+  EXPECT_THROW(CleanMesh(&V, &F4), InputError);
+  EXPECT_THROW(Decimate(&Vn, &F, 10), InputError);
+  EXPECT_THROW(SubdivideMidpoint(&Vn, &F), InputError);
+  EXPECT_THROW(CountSelfIntersections(Vn, F), InputError);
+}
+
+TEST(Remesh, EmptyMesh) {
+  Eigen::MatrixXd V(0, 3);
+  Eigen::MatrixXi F(0, 3);
+  EXPECT_NO_THROW(Decimate(&V, &F, 10));
+  EXPECT_NO_THROW(SubdivideSqrt3(&V, &F));
+  EXPECT_NO_THROW(SubdivideMidpoint(&V, &F));
+  EXPECT_NO_THROW(IsotropicRemesh(&V, &F, 0.1));
+  const CleanMeshReport r = CleanMesh(&V, &F);
+  EXPECT_EQ(r.final_faces, 0);
+  EXPECT_EQ(CountSelfIntersections(V, F).intersecting_pairs, 0);
+  EXPECT_EQ(RemoveSelfIntersections(&V, &F).final_pairs, 0);
+  EXPECT_EQ(CountFlippedFaces(V, V, F), 0);
+  EXPECT_EQ(V.rows(), 0);
+  EXPECT_EQ(F.rows(), 0);
+  // Default-constructed (0 by 0) matrices too.
+  Eigen::MatrixXd V0;
+  Eigen::MatrixXi F0;
+  EXPECT_NO_THROW(CleanMesh(&V0, &F0));
+  EXPECT_NO_THROW(SubdivideMidpoint(&V0, &F0));
+}
+
+TEST(Remesh, RandomSoupsNeverCrash) {
+  // Random triangle soups (with repeated indices, duplicates, coincident
+  // points, non-manifold edges): CleanMesh must make them usable, and the
+  // CGAL functions must either work or throw InputError.
+  std::srand(7);
+  int usable = 0;
+  for (int trial = 0; trial < 20; ++trial) {
+    const int nv = 10 + trial * 3, nf = 3 * nv;
+    Eigen::MatrixXd V = Eigen::MatrixXd::Random(nv, 3);
+    for (int v = 0; v < nv; v += 7) V.row(v) = V.row(0);  // exact duplicates
+    Eigen::MatrixXi F(nf, 3);
+    for (int f = 0; f < nf; ++f)
+      for (int k = 0; k < 3; ++k) F(f, k) = std::rand() % nv;
+    const CleanMeshReport r = CleanMesh(&V, &F);
+    EXPECT_EQ(r.remaining_non_manifold_edges, 0) << "trial " << trial;
+    EXPECT_EQ(r.remaining_non_manifold_vertices, 0) << "trial " << trial;
+    if (!r.IsCleanManifold()) continue;  // a non-orientable component
+    ++usable;
+    const double edge = MeanEdgeLength(V, F);
+    auto run = [&](auto&& fn) {
+      Eigen::MatrixXd W = V;
+      Eigen::MatrixXi G = F;
+      try {
+        fn(&W, &G);
+      } catch (const InputError&) {
+      }
+    };
+    run([&](Eigen::MatrixXd* W, Eigen::MatrixXi* G) { CountSelfIntersections(*W, *G); });
+    run([&](Eigen::MatrixXd* W, Eigen::MatrixXi* G) { Decimate(W, G, std::max(1, nf / 4)); });
+    run([&](Eigen::MatrixXd* W, Eigen::MatrixXi* G) { SubdivideSqrt3(W, G); });
+    run([&](Eigen::MatrixXd* W, Eigen::MatrixXi* G) { IsotropicRemesh(W, G, edge); });
+    run([&](Eigen::MatrixXd* W, Eigen::MatrixXi* G) { RemoveSelfIntersections(W, G); });
+  }
+  EXPECT_GE(usable, 10);  // the CGAL functions really ran on cleaned soups
+}
+
+TEST(SubdivideSqrt3, OpenMesh) {
+  Eigen::MatrixXd V;
+  Eigen::MatrixXi F;
+  Icosphere(2, &V, &F);
+  Eigen::MatrixXi H(F.rows(), 3);
+  int n = 0;
+  for (int f = 0; f < F.rows(); ++f) {
+    if (V(F(f, 0), 2) + V(F(f, 1), 2) + V(F(f, 2), 2) > 0) H.row(n++) = F.row(f);
+  }
+  H.conservativeResize(n, 3);
+  F = H;
+  RemoveUnreferencedVertices(&V, &F);
+  const int nb = ComputeEdgeTopology(F, V.rows()).NumBoundaryEdges();
+  ASSERT_GT(nb, 0);
+  SubdivideSqrt3(&V, &F);
+  EXPECT_GE(F.rows(), 3 * n);
+  const EdgeTopology topo = ComputeEdgeTopology(F, V.rows());
+  EXPECT_EQ(topo.NumNonManifoldEdges(), 0);
+  EXPECT_GE(topo.NumBoundaryEdges(), nb);
+}
+
+TEST(Remesh, NonManifoldInputToCgalThrows) {
+  // Three triangles on one edge.
+  Eigen::MatrixXd V(5, 3);
+  V << 0, 0, 0, 1, 0, 0, 0, 1, 0, 0, -1, 0, 0, 0, 1;
+  Eigen::MatrixXi F(3, 3);
+  F << 0, 1, 2, 1, 0, 3, 0, 1, 4;
+  EXPECT_THROW(CountSelfIntersections(V, F), InputError);
+  EXPECT_THROW(SubdivideSqrt3(&V, &F), InputError);
+  const CleanMeshReport r = CleanMesh(&V, &F);
+  EXPECT_EQ(r.non_manifold_edges, 1);
+  EXPECT_EQ(r.remaining_non_manifold_edges, 0);
+  EXPECT_NO_THROW(CountSelfIntersections(V, F));
+}
+
+// A sphere with vertex 0 pushed through the opposite side.
+void PiercedSphere(Eigen::MatrixXd* V, Eigen::MatrixXi* F) {
+  Icosphere(3, V, F);
+  V->row(0) *= -1.5;
+}
+
+TEST(SelfIntersections, SphereHasNone) {
+  Eigen::MatrixXd V;
+  Eigen::MatrixXi F;
+  Icosphere(3, &V, &F);
+  const SelfIntersectionReport r = CountSelfIntersections(V, F);
+  EXPECT_EQ(r.intersecting_pairs, 0);
+  EXPECT_EQ(r.intersecting_faces, 0);
+}
+
+TEST(SelfIntersections, PushedVertexIntersects) {
+  Eigen::MatrixXd V;
+  Eigen::MatrixXi F;
+  PiercedSphere(&V, &F);
+  const SelfIntersectionReport r = CountSelfIntersections(V, F, true);
+  EXPECT_GT(r.intersecting_pairs, 0);
+  EXPECT_EQ(static_cast<long>(r.pairs.size()), r.intersecting_pairs);
+  // Every pair involves one of the (long) faces around vertex 0.
+  for (const auto& p : r.pairs) {
+    const bool a = (F.row(p.first).array() == 0).any(), b = (F.row(p.second).array() == 0).any();
+    EXPECT_TRUE(a || b);
+  }
+}
+
+TEST(SelfIntersections, RemoveBySmoothing) {
+  Eigen::MatrixXd V;
+  Eigen::MatrixXi F;
+  PiercedSphere(&V, &F);
+  RemoveSelfIntersectionsOptions options;
+  options.use_cgal_repair = false;
+  const int nv = V.rows();
+  const RemoveSelfIntersectionsSummary s = RemoveSelfIntersections(&V, &F, options);
+  EXPECT_GT(s.initial_pairs, 0);
+  EXPECT_EQ(s.final_pairs, 0);
+  EXPECT_EQ(V.rows(), nv);  // smoothing keeps the connectivity
+  EXPECT_EQ(CountSelfIntersections(V, F).intersecting_pairs, 0);
+}
+
+TEST(SelfIntersections, RemoveWithCgalRepair) {
+  Eigen::MatrixXd V;
+  Eigen::MatrixXi F;
+  PiercedSphere(&V, &F);
+  const RemoveSelfIntersectionsSummary s = RemoveSelfIntersections(&V, &F);
+  EXPECT_TRUE(s.cgal_repair_used);
+  EXPECT_EQ(s.final_pairs, 0);
+  EXPECT_EQ(CountSelfIntersections(V, F).intersecting_pairs, 0);
+}
+
+// A flat 3x3 vertex grid on z = 0 (8 triangles, CCW seen from +z); the
+// centre vertex 4 is at (1, 1).
+void Grid(Eigen::MatrixXd* V, Eigen::MatrixXi* F) {
+  V->resize(9, 3);
+  for (int j = 0; j < 3; ++j)
+    for (int i = 0; i < 3; ++i) V->row(i + 3 * j) << i, j, 0;
+  F->resize(8, 3);
+  *F << 0, 1, 4, 0, 4, 3, 1, 2, 5, 1, 5, 4, 3, 4, 7, 3, 7, 6, 4, 5, 8, 4, 8, 7;
+}
+
+TEST(FlippedFaces, DetectsConstructedFlip) {
+  Eigen::MatrixXd V;
+  Eigen::MatrixXi F;
+  Grid(&V, &F);
+  EXPECT_EQ(CountFlippedFaces(V, V, F), 0);
+  Eigen::MatrixXd W = V;
+  // Centre to (2.5, 1): it crosses the lines x = 2 (edge 5-8) and x - y = 1
+  // (edge 1-5): faces (1,5,4) and (4,5,8) fold over (normal -z), no other.
+  W.row(4) << 2.5, 1, 0;
+  EXPECT_EQ(FlippedFaces(V, W, F), (std::vector<int>{3, 6}));
+  // Inside its ring nothing folds.
+  W.row(4) << 1.4, 0.7, 0;
+  EXPECT_EQ(CountFlippedFaces(V, W, F), 0);
+  // Lifting out of the plane turns normals by less than 90 degrees.
+  W.row(4) << 1, 1, 5;
+  EXPECT_EQ(CountFlippedFaces(V, W, F), 0);
+  // ... but by more than 45 (tilt atan(5 / 0.71..1) > 78 deg) for the 6
+  // faces around vertex 4 (faces 2 and 5 do not contain it).
+  EXPECT_EQ(CountFlippedFaces(V, W, F, 45.0), 6);
+  EXPECT_THROW(CountFlippedFaces(V, W.topRows(5), F), InputError);
+}
+
+TEST(FlippedFaces, FixBySmoothing) {
+  Eigen::MatrixXd V;
+  Eigen::MatrixXi F;
+  Grid(&V, &F);
+  Eigen::MatrixXd W = V;
+  W.row(4) << 2.5, 1, 0;
+  const FixFlippedFacesSummary s = FixFlippedFaces(V, F, &W);
+  EXPECT_EQ(s.initial_flipped, 2);
+  EXPECT_EQ(s.final_flipped, 0);
+  EXPECT_EQ(CountFlippedFaces(V, W, F), 0);
+  EXPECT_GT(s.smoothing_rounds_done, 0);
+  EXPECT_EQ(s.reset_vertices, 0);
+  // Vertices of no flipped face did not move.
+  for (int v : {0, 3, 6, 7}) EXPECT_EQ(W.row(v), V.row(v));
+}
+
+TEST(FlippedFaces, FixByResetWithoutSmoothing) {
+  Eigen::MatrixXd V;
+  Eigen::MatrixXi F;
+  Icosphere(2, &V, &F);
+  Eigen::MatrixXd W = V;
+  // Push vertex 0 sideways past its neighbours: part of its fan folds.
+  const int far = F(0, 1);
+  W.row(0) = V.row(0) + 3.0 * (V.row(far) - V.row(0));
+  ASSERT_GT(CountFlippedFaces(V, W, F), 0);
+  FixFlippedFacesOptions options;
+  options.smoothing_rounds = 0;
+  const FixFlippedFacesSummary s = FixFlippedFaces(V, F, &W, options);
+  EXPECT_EQ(s.final_flipped, 0);
+  EXPECT_EQ(s.reset_vertices, 1);
+  EXPECT_EQ(W, V);
+}
+
+}  // namespace
+}  // namespace mr

@@ -1,0 +1,89 @@
+#pragma once
+
+// The data term of DCV for one ordered view pair (i, j): the predicted image
+// Î_ij (image j warped into view i through the current mesh), its similarity
+// to image i, and the derivative of that similarity with respect to the
+// mesh vertices.
+//
+// Chain rule (the discrete form of the paper's eq. pf3-pf4). Pixel p of view
+// i sees point x = C_i + d r_p (r_p the pixel ray, unit camera z) on face f
+// with unit normal n and barycentric weights w. Moving vertex k of f by δ
+// moves the plane of f at x by w_k δ, so the ray's hit point moves by
+//   dx = r_p (n · w_k δ) / (n · r_p),
+// and the predicted intensity Î(p) = I_j(π_j(x)) changes by
+//   dÎ(p) = ∇I_j(π_j x)ᵀ Jπ_j(x) r_p (n · w_k δ) / (n · r_p).
+// With g(p) = ∂C/∂Î(p) from the similarity measure (C = Σ_p (1 - m(p)), the
+// reprojection error), the vertex gradient is
+//   ∂C/∂X_k = Σ_p w_k(p) g(p) a(p) n(p),  a = ∇I_jᵀ Jπ_j r_p / (n · r_p).
+// Pixels whose x is hidden in view j, falls outside image j, or is seen at a
+// grazing angle are outside the valid domain π_i∘S_ij and contribute nothing.
+//
+// The depth d is recomputed in double precision from the face's plane, so the
+// term is exact given the visible face of each pixel.
+//
+// Alongside the gradient a Gauss-Newton curvature H_k = Σ_p w_k a² / v₂(p)
+// is accumulated (v₂ the local variance of Î; 1/v₂ is the curvature of
+// 1 - ZNCC with respect to one predicted pixel near a match). The refiner
+// steps by -G_k / H_k, which is invariant to the scale of the scene.
+
+#include <opencv2/core.hpp>
+
+#include <Eigen/Core>
+
+#include "geometry/view.h"
+#include "refine/similarity.h"
+#include "render/renderer.h"
+
+namespace mr {
+
+struct PairTermOptions {
+  // Depth test in view j: a point is visible if its depth is within this many
+  // pixel footprints of the rendered depth (divided by the cosine of the
+  // viewing angle, capped at 5x).
+  double visibility_tolerance_px = 1.5;
+  // Pixels seen at |cos(angle between ray and normal)| below this in either
+  // view are dropped (grazing surfaces give unreliable warps).
+  double min_cos_angle = 0.15;
+  bool Check() const;
+};
+
+// Per-vertex sums over pixels and pairs.
+struct DataTerm {
+  Eigen::MatrixXd gradient;   // #V by 3: ∂C/∂X (C = reprojection error, to be decreased)
+  Eigen::VectorXd curvature;  // #V: Gauss-Newton curvature along the normal
+  Eigen::VectorXd weight;     // #V: Σ_p w_k (pixel coverage)
+  Eigen::VectorXd footprint;  // #V: Σ_p w_k * (pixel footprint in world units)
+  double cost = 0;            // C = Σ_p W(p) (1 - m(p)) over all pairs
+  double zncc_sum = 0;        // Σ_p W(p) m(p)
+  double weight_sum = 0;      // Σ_p W(p)
+  long valid_pixels = 0;
+
+  void Reset(int num_vertices);
+  void Add(const DataTerm& other);
+  // Mean local ZNCC over the valid pixels of all pairs, in [-1, 1].
+  double MeanSimilarity() const { return weight_sum > 0 ? zncc_sum / weight_sum : 0.0; }
+};
+
+// The mesh as the pair term needs it.
+struct MeshGeometry {
+  const Eigen::MatrixXd* V = nullptr;  // #V by 3
+  const Eigen::MatrixXi* F = nullptr;  // #F by 3
+  Eigen::MatrixXd face_normals;        // #F by 3 unit normals
+};
+
+// Builds the predicted image Î_ij in view i (CV_64F, 0 outside the valid
+// domain) and the valid-domain mask (CV_8U, 255 = valid). `image_j` is CV_32F.
+void PredictImage(const MeshGeometry& mesh, const PinholeView& view_i,
+                  const RenderBuffers& render_i, const PinholeView& view_j,
+                  const RenderBuffers& render_j, const cv::Mat& image_j,
+                  const PairTermOptions& options, cv::Mat* predicted, cv::Mat* mask);
+
+// Adds the data term of the ordered pair (i, j) to `term` (sized for the mesh).
+// Returns the number of valid pixels.
+long AccumulatePairTerm(const MeshGeometry& mesh, const PinholeView& view_i,
+                        const RenderBuffers& render_i, const cv::Mat& image_i,
+                        const PinholeView& view_j, const RenderBuffers& render_j,
+                        const cv::Mat& image_j, const SimilarityOptions& similarity,
+                        const PairTermOptions& options, DataTerm* term);
+
+}  // namespace mr

@@ -1,0 +1,101 @@
+#include <gtest/gtest.h>
+
+#include <random>
+
+#include "geometry/mesh.h"
+#include "refine/photometric.h"
+#include "render/renderer.h"
+
+namespace mr {
+namespace {
+
+// A smooth test image: sinusoids, values in [0.1, 0.9].
+cv::Mat SmoothImage(int width, int height, double phase) {
+  cv::Mat image(height, width, CV_32F);
+  for (int r = 0; r < height; ++r) {
+    for (int c = 0; c < width; ++c) {
+      image.at<float>(r, c) = static_cast<float>(
+          0.5 + 0.2 * std::sin(0.31 * c + phase) * std::cos(0.23 * r) +
+          0.15 * std::sin(0.17 * (c + r) + 2 * phase));
+    }
+  }
+  return image;
+}
+
+// Total similarity cost C over both orderings of the pair, with exact CPU renders.
+double PairCost(const Eigen::MatrixXd& V, const Eigen::MatrixXi& F, const PinholeView& a,
+                const PinholeView& b, const cv::Mat& image_a, const cv::Mat& image_b,
+                const SimilarityOptions& similarity, DataTerm* term) {
+  MeshGeometry mesh{&V, &F, FaceNormals(V, F)};
+  const RenderBuffers ra = RenderCpu(V, F, a), rb = RenderCpu(V, F, b);
+  term->Reset(static_cast<int>(V.rows()));
+  PairTermOptions options;
+  AccumulatePairTerm(mesh, a, ra, image_a, b, rb, image_b, similarity, options, term);
+  AccumulatePairTerm(mesh, b, rb, image_b, a, ra, image_a, similarity, options, term);
+  return term->cost;
+}
+
+// A bumpy height field z = h(x, y) seen by two cameras from above; it covers
+// both images entirely so that no pixel changes visibility under tiny moves.
+void HeightField(Eigen::MatrixXd* V, Eigen::MatrixXi* F) {
+  const int n = 9;
+  V->resize(n * n, 3);
+  for (int i = 0; i < n; ++i) {
+    for (int j = 0; j < n; ++j) {
+      const double x = -2.0 + 4.0 * j / (n - 1), y = -2.0 + 4.0 * i / (n - 1);
+      V->row(i * n + j) << x, y, 0.15 * std::sin(1.3 * x) * std::cos(0.9 * y);
+    }
+  }
+  F->resize(2 * (n - 1) * (n - 1), 3);
+  int f = 0;
+  for (int i = 0; i + 1 < n; ++i) {
+    for (int j = 0; j + 1 < n; ++j) {
+      const int v00 = i * n + j, v01 = v00 + 1, v10 = v00 + n, v11 = v10 + 1;
+      F->row(f++) << v00, v01, v11;
+      F->row(f++) << v00, v11, v10;
+    }
+  }
+}
+
+TEST(PairTerm, VertexGradientMatchesFiniteDifferences) {
+  Eigen::MatrixXd V;
+  Eigen::MatrixXi F;
+  HeightField(&V, &F);
+  const PinholeView a = LookAtView(Eigen::Vector3d(-0.3, 0, 4), Eigen::Vector3d::Zero(),
+                                   Eigen::Vector3d(0, 1, 0), 40, 32, 40);
+  const PinholeView b = LookAtView(Eigen::Vector3d(0.4, 0.2, 4), Eigen::Vector3d::Zero(),
+                                   Eigen::Vector3d(0, 1, 0), 40, 32, 40);
+  const cv::Mat image_a = SmoothImage(40, 32, 0.0), image_b = SmoothImage(40, 32, 0.7);
+  for (const std::string method : {"zncc", "dcv"}) {
+    SimilarityOptions similarity;
+    similarity.method = method;
+    similarity.kappa = 0.0;  // with κ = 0 the dcv direction is the exact gradient
+    similarity.double_precision = true;
+    DataTerm term;
+    PairCost(V, F, a, b, image_a, image_b, similarity, &term);
+    const Eigen::MatrixXd analytic = term.gradient;
+    std::mt19937 rng(3);
+    std::normal_distribution<double> normal;
+    int checked = 0;
+    for (int v : {30, 31, 40, 41, 49, 50}) {
+      ASSERT_GT(term.weight(v), 0) << "vertex " << v << " is not seen";
+      const Eigen::Vector3d dir = Eigen::Vector3d(normal(rng), normal(rng), normal(rng)).normalized();
+      const double h = 1e-6;
+      Eigen::MatrixXd Vp = V, Vm = V;
+      Vp.row(v) += h * dir.transpose();
+      Vm.row(v) -= h * dir.transpose();
+      DataTerm tp, tm;
+      const double fd = (PairCost(Vp, F, a, b, image_a, image_b, similarity, &tp) -
+                         PairCost(Vm, F, a, b, image_a, image_b, similarity, &tm)) /
+                        (2 * h);
+      const double an = analytic.row(v).dot(dir);
+      EXPECT_NEAR(an, fd, 2e-3 * std::max(1.0, std::abs(fd)))
+          << method << " vertex " << v << " analytic " << an << " fd " << fd;
+      ++checked;
+    }
+    EXPECT_EQ(checked, 6);
+  }
+}
+
+}  // namespace
+}  // namespace mr

@@ -1,0 +1,425 @@
+#include "refine/refiner.h"
+
+#include <algorithm>
+#include <cmath>
+#include <iomanip>
+#include <list>
+#include <memory>
+#include <set>
+#include <sstream>
+
+#include <opencv2/imgproc.hpp>
+
+#include "geometry/mesh.h"
+#include "geometry/remesh.h"
+#include "refine/pyramid.h"
+#include "refine/silhouette.h"
+#include "render/renderer.h"
+#include "util/error.h"
+#include "util/logging.h"
+
+namespace mr {
+namespace {
+
+// Renders of the current mesh in the views of one level, made on demand and
+// kept in a least-recently-used cache bounded in bytes. Invalidate() after
+// the mesh moves.
+class RenderCache {
+ public:
+  RenderCache(Renderer* renderer, const std::vector<PinholeView>& views, size_t max_bytes)
+      : renderer_(renderer), views_(views), max_bytes_(max_bytes) {}
+
+  std::shared_ptr<const RenderBuffers> Get(int i) {
+    for (auto it = entries_.begin(); it != entries_.end(); ++it) {
+      if (it->first == i) {
+        entries_.splice(entries_.begin(), entries_, it);
+        return entries_.front().second;
+      }
+    }
+    auto render = std::make_shared<const RenderBuffers>(renderer_->Render(views_[i]));
+    const size_t bytes = static_cast<size_t>(render->width) * render->height * 16;
+    entries_.emplace_front(i, render);
+    bytes_ += bytes;
+    while (bytes_ > max_bytes_ && entries_.size() > 1) {
+      const auto& last = entries_.back().second;
+      bytes_ -= static_cast<size_t>(last->width) * last->height * 16;
+      entries_.pop_back();
+    }
+    ++num_renders_;
+    return render;
+  }
+  void Invalidate() {
+    entries_.clear();
+    bytes_ = 0;
+  }
+  long num_renders() const { return num_renders_; }
+
+ private:
+  Renderer* renderer_;
+  const std::vector<PinholeView>& views_;
+  size_t max_bytes_;
+  size_t bytes_ = 0;
+  long num_renders_ = 0;
+  std::list<std::pair<int, std::shared_ptr<const RenderBuffers>>> entries_;
+};
+
+std::vector<PinholeView> ScaledViews(const ViewSource& source, int level) {
+  std::vector<PinholeView> views;
+  for (int i = 0; i < source.NumViews(); ++i) {
+    views.push_back(PyramidLevelView(source.View(i), level));
+  }
+  return views;
+}
+
+// Remeshes to the level's target edge length, within the face budget.
+void RemeshForLevel(const std::vector<PinholeView>& views, const RefineOptions& options,
+                    int max_faces, Eigen::MatrixXd* V, Eigen::MatrixXi* F) {
+  const double footprint = MedianFootprint(views, *V, VertexNormals(*V, *F));
+  if (!(footprint > 0)) MR_THROW_INPUT << "the mesh is not visible in any view";
+  double edge = options.target_edge_px * footprint;
+  // Faces of an isotropic mesh with this edge length: area / (√3/4 e²).
+  const double area = FaceAreas(*V, *F).sum();
+  const double faces_at_edge = area / (std::sqrt(3.0) / 4.0 * edge * edge);
+  if (faces_at_edge > max_faces) edge *= std::sqrt(faces_at_edge / max_faces);
+  const int target_faces = static_cast<int>(area / (std::sqrt(3.0) / 4.0 * edge * edge));
+  const double t0 = ElapsedSeconds();
+  const int faces_before = static_cast<int>(F->rows());
+  if (faces_before > 2 * target_faces) {
+    // Large reductions by quadric decimation first (Garland-Heckbert), which
+    // keeps the shape better than collapsing to length alone.
+    MR_LOG(VERBOSE) << Decimate(V, F, std::max(4, target_faces)).BriefReport();
+  }
+  MR_LOG(VERBOSE) << IsotropicRemesh(V, F, edge).BriefReport();
+  MR_LOG(INFO) << "Remeshed " << faces_before << " -> " << F->rows() << " faces (edge "
+               << edge / footprint << " px at this level, " << ElapsedSeconds() - t0 << " s)";
+}
+
+// Median of the positive entries, or 0.
+double MedianPositive(const Eigen::VectorXd& x) {
+  std::vector<double> values;
+  for (int i = 0; i < x.size(); ++i) {
+    if (x(i) > 0) values.push_back(x(i));
+  }
+  if (values.empty()) return 0;
+  std::nth_element(values.begin(), values.begin() + values.size() / 2, values.end());
+  return values[values.size() / 2];
+}
+
+// Sums the data term over all ordered pairs of the level.
+DataTerm ComputeDataTerm(const MeshGeometry& mesh, const std::vector<PinholeView>& views,
+                         const std::vector<std::pair<int, int>>& pairs, int level,
+                         const SimilarityOptions& similarity, const PairTermOptions& pair_options,
+                         RenderCache* renders, ImageCache* images) {
+  DataTerm term;
+  term.Reset(static_cast<int>(mesh.V->rows()));
+  for (const auto& [a, b] : pairs) {
+    for (int dir = 0; dir < 2; ++dir) {
+      const int i = dir == 0 ? a : b, j = dir == 0 ? b : a;
+      const auto render_i = renders->Get(i);
+      const auto render_j = renders->Get(j);
+      AccumulatePairTerm(mesh, views[i], *render_i, images->Gray(i, level), views[j], *render_j,
+                         images->Gray(j, level), similarity, pair_options, &term);
+    }
+  }
+  return term;
+}
+
+// Per-vertex colours: the mean colour of each vertex over the views where
+// it is visible, weighted by the cosine of the viewing angle.
+void SampleVertexColors(const ViewSource& source, const Eigen::MatrixXd& V,
+                        const Eigen::MatrixXi& F, Renderer* renderer,
+                        Eigen::Matrix<uint8_t, Eigen::Dynamic, 3>* colors) {
+  const Eigen::MatrixXd N = VertexNormals(V, F);
+  Eigen::MatrixXd sum = Eigen::MatrixXd::Zero(V.rows(), 3);
+  Eigen::VectorXd weight = Eigen::VectorXd::Zero(V.rows());
+  renderer->SetMesh(V, F);
+  for (int i = 0; i < source.NumViews(); ++i) {
+    const PinholeView& view = source.View(i);
+    const RenderBuffers render = renderer->Render(view);
+    const cv::Mat color = source.LoadColor(i);
+    for (int v = 0; v < V.rows(); ++v) {
+      const Eigen::Vector3d x = V.row(v);
+      const Eigen::Vector3d xc = view.WorldToCamera(x);
+      if (xc.z() <= 0) continue;
+      const Eigen::Vector2d p = view.CameraToImage(xc);
+      if (!view.InImage(p)) continue;
+      const int col = static_cast<int>(p.x()), row = static_cast<int>(p.y());
+      const float d = render.DepthAt(row, col);
+      if (render.FaceAt(row, col) < 0 || std::abs(d - xc.z()) > 0.01 * xc.z()) continue;
+      const double w = N.row(v).dot((view.Center() - x).normalized());
+      if (w <= 0) continue;
+      const cv::Vec3b bgr = color.at<cv::Vec3b>(row, col);
+      sum.row(v) += w * Eigen::Vector3d(bgr[2], bgr[1], bgr[0]).transpose();
+      weight(v) += w;
+    }
+  }
+  colors->resize(V.rows(), 3);
+  for (int v = 0; v < V.rows(); ++v) {
+    const Eigen::Vector3d c =
+        weight(v) > 0 ? Eigen::Vector3d(sum.row(v) / weight(v)) : Eigen::Vector3d(128, 128, 128);
+    for (int k = 0; k < 3; ++k) (*colors)(v, k) = static_cast<uint8_t>(std::clamp(c(k), 0.0, 255.0));
+  }
+}
+
+std::string FormatSeconds(double s) {
+  std::ostringstream out;
+  out << std::fixed << std::setprecision(1) << s << " s";
+  return out.str();
+}
+
+}  // namespace
+
+bool RefineOptions::Check() const {
+  auto fail = [](const std::string& field, const std::string& value, const std::string& bound) {
+    MR_THROW_INPUT << "RefineOptions::" << field << " = " << value
+                   << ". Violated constraint: " << bound;
+  };
+  if (num_levels < 1 || num_levels > 6) fail("num_levels", std::to_string(num_levels), "1 <= num_levels <= 6");
+  if (iterations_per_level < 0) fail("iterations_per_level", std::to_string(iterations_per_level), "iterations_per_level >= 0");
+  if (!(target_edge_px > 0)) fail("target_edge_px", std::to_string(target_edge_px), "target_edge_px > 0");
+  if (max_faces < 0) fail("max_faces", std::to_string(max_faces), "max_faces >= 0");
+  if (!(step > 0 && step <= 1)) fail("step", std::to_string(step), "0 < step <= 1");
+  if (!(max_step_px > 0)) fail("max_step_px", std::to_string(max_step_px), "max_step_px > 0");
+  if (!(damping >= 0)) fail("damping", std::to_string(damping), "damping >= 0");
+  if (similarity != "dcv" && similarity != "zncc") fail("similarity", similarity, "one of dcv, zncc");
+  if (!(kappa >= 0)) fail("kappa", std::to_string(kappa), "kappa >= 0");
+  if (regularizer != "lp" && regularizer != "laplacian" && regularizer != "none") {
+    fail("regularizer", regularizer, "one of lp, laplacian, none");
+  }
+  if (!(silhouette_weight >= 0)) fail("silhouette_weight", std::to_string(silhouette_weight), "silhouette_weight >= 0");
+  if (cache_mb < 64) fail("cache_mb", std::to_string(cache_mb), "cache_mb >= 64");
+  view_selection.Check();
+  similarity_options.Check();
+  pair.Check();
+  denoise.Check();
+  return true;
+}
+
+std::string RefineSummary::BriefReport() const {
+  std::ostringstream out;
+  out << "DCV refinement: " << termination << ", " << iterations.size() << " iterations, "
+      << initial_faces << " -> " << final_faces << " faces, mean similarity " << std::setprecision(4)
+      << initial_similarity << " -> " << final_similarity << ", " << FormatSeconds(seconds);
+  return out.str();
+}
+
+std::string RefineSummary::FullReport() const {
+  std::ostringstream out;
+  out << BriefReport() << "\n";
+  out << "  views " << num_views << ", pairs " << num_pairs << ", vertices " << initial_vertices
+      << " -> " << final_vertices << ", flipped faces fixed " << flipped_faces_fixed
+      << ", self-intersections " << self_intersections << "\n";
+  out << "  level iter  faces  similarity  kappa  step_px(mean/max)  regulariser  seconds\n";
+  for (const auto& it : iterations) {
+    out << "  " << std::setw(5) << it.level << std::setw(5) << it.iteration << std::setw(7)
+        << it.faces << "  " << std::fixed << std::setprecision(4) << it.mean_similarity << "  "
+        << std::setprecision(3) << it.kappa << "  " << it.mean_step_px << "/" << it.max_step_px
+        << "  " << it.regularizer_report << "  " << std::setprecision(2) << it.seconds << "\n";
+    out.unsetf(std::ios::fixed);
+  }
+  return out.str();
+}
+
+RefineSummary RefineMesh(const ViewSource& source, const RefineOptions& options,
+                         TriangleMesh* mesh, Renderer* renderer) {
+  options.Check();
+  const double t_start = ElapsedSeconds();
+  if (mesh->NumFaces() == 0 || mesh->NumVertices() == 0) {
+    MR_THROW_INPUT << "the input mesh is empty (" << mesh->NumVertices() << " vertices, "
+                   << mesh->NumFaces() << " faces)";
+  }
+  if (source.NumViews() < 2) {
+    MR_THROW_INPUT << "refinement needs at least 2 views, got " << source.NumViews();
+  }
+  std::unique_ptr<Renderer> own_renderer;
+  if (renderer == nullptr) {
+    own_renderer = std::make_unique<Renderer>();
+    renderer = own_renderer.get();
+  }
+
+  RefineSummary summary;
+  summary.num_views = source.NumViews();
+  summary.initial_faces = mesh->NumFaces();
+  summary.initial_vertices = mesh->NumVertices();
+  Eigen::MatrixXd V = mesh->V;
+  Eigen::MatrixXi F = mesh->F;
+
+  const CleanMeshReport clean = CleanMesh(&V, &F);
+  MR_LOG(INFO) << "Input mesh: " << clean.BriefReport();
+  if (F.rows() == 0) MR_THROW_INPUT << "the input mesh has no valid faces after cleaning";
+  if (!clean.IsCleanManifold()) {
+    MR_THROW_INPUT << "the input mesh could not be made an oriented 2-manifold ("
+                   << clean.BriefReport() << ")";
+  }
+
+  const std::vector<PinholeView> full_views = source.Views();
+  const auto neighbors = SelectNeighbors(full_views, V, VertexNormals(V, F), options.view_selection);
+  const auto pairs = NeighborPairs(neighbors);
+  summary.num_pairs = static_cast<int>(pairs.size());
+  if (pairs.empty()) {
+    MR_THROW_INPUT << "no two views overlap on the mesh: nothing to compare (check the cameras "
+                      "and that the mesh lies in front of them)";
+  }
+  MR_LOG(INFO) << "Selected " << pairs.size() << " view pairs among " << source.NumViews()
+               << " views";
+
+  const int max_faces =
+      options.max_faces > 0 ? options.max_faces : std::max(100000, 2 * summary.initial_faces);
+  const size_t cache_bytes = static_cast<size_t>(options.cache_mb) << 20;
+  ImageCache images(source, cache_bytes / 2);
+
+  SimilarityOptions similarity = options.similarity_options;
+  similarity.method = options.similarity;
+  DenoiseOptions denoise = options.denoise;
+  denoise.method = options.regularizer == "laplacian" ? "laplacian" : "lp";
+
+  const int total_iterations = options.num_levels * options.iterations_per_level;
+  int global_iteration = 0;
+  for (int level = options.num_levels - 1; level >= 0; --level) {
+    const std::vector<PinholeView> views = ScaledViews(source, level);
+    RemeshForLevel(views, options, max_faces, &V, &F);
+    RenderCache renders(renderer, views, cache_bytes / 2);
+    MR_LOG(INFO) << "Level " << level << ": " << views[0].width << "x" << views[0].height
+                 << " images, " << F.rows() << " faces";
+    const bool use_silhouettes = options.silhouette_weight > 0 && source.HasMasks();
+    for (int it = 0; it < options.iterations_per_level; ++it, ++global_iteration) {
+      const double t_iter = ElapsedSeconds();
+      RefineIteration record;
+      record.level = level;
+      record.iteration = it;
+      record.faces = static_cast<int>(F.rows());
+      record.kappa = options.similarity == "dcv"
+                         ? options.kappa * (global_iteration + 1) / std::max(1, total_iterations)
+                         : 0.0;
+      similarity.kappa = record.kappa;
+
+      const Eigen::MatrixXd V_before = V;
+      renderer->SetMesh(V, F);
+      renders.Invalidate();
+      MeshGeometry geometry{&V, &F, FaceNormals(V, F)};
+      const DataTerm term = ComputeDataTerm(geometry, views, pairs, level, similarity,
+                                            options.pair, &renders, &images);
+      record.mean_similarity = term.MeanSimilarity();
+      if (term.valid_pixels == 0) {
+        MR_THROW_INPUT << "no pixel of any view pair sees a common surface point: the mesh is "
+                          "not visible in overlapping views";
+      }
+
+      // Gauss-Newton step down the reprojection error, clamped to max_step_px
+      // footprints.
+      const double mu = options.damping * MedianPositive(term.curvature);
+      Eigen::MatrixXd step = Eigen::MatrixXd::Zero(V.rows(), 3);
+      double step_sum = 0, step_max = 0;
+      long num_moved = 0;
+      for (int v = 0; v < V.rows(); ++v) {
+        if (!(term.weight(v) > 0) || !(term.curvature(v) + mu > 0)) continue;
+        Eigen::Vector3d d = -options.step * term.gradient.row(v) / (term.curvature(v) + mu);
+        const double footprint = term.footprint(v) / term.weight(v);
+        const double limit = options.max_step_px * footprint;
+        if (d.norm() > limit) d *= limit / d.norm();
+        step.row(v) = d.transpose();
+        step_sum += d.norm() / footprint;
+        step_max = std::max(step_max, d.norm() / footprint);
+        ++num_moved;
+      }
+      record.mean_step_px = num_moved > 0 ? step_sum / num_moved : 0;
+      record.max_step_px = step_max;
+
+      if (use_silhouettes) {
+        Eigen::MatrixXd sil = Eigen::MatrixXd::Zero(V.rows(), 3);
+        Eigen::VectorXd count = Eigen::VectorXd::Zero(V.rows());
+        const Eigen::MatrixXd N = VertexNormals(V, F);
+        for (int i = 0; i < static_cast<int>(views.size()); ++i) {
+          const cv::Mat mask = images.Mask(i, level);
+          if (mask.empty()) continue;
+          AccumulateSilhouetteTerm(V, F, N, views[i], *renders.Get(i), SignedDistanceToMask(mask),
+                                   3.0 * options.max_step_px, &sil, &count);
+        }
+        for (int v = 0; v < V.rows(); ++v) {
+          if (count(v) > 0) {
+            step.row(v) += options.step * options.silhouette_weight * sil.row(v) / count(v);
+          }
+        }
+      }
+
+      const Eigen::MatrixXd V_half = V + step;
+      if (options.regularizer != "none") {
+        const DenoiseResult denoised = Denoise(V_half, F, denoise);
+        record.regularizer_report = denoised.BriefReport();
+        V = denoised.V;
+      } else {
+        V = V_half;
+      }
+      summary.flipped_faces_fixed += FixFlippedFaces(V_before, F, &V).initial_flipped;
+
+      record.seconds = ElapsedSeconds() - t_iter;
+      MR_LOG(INFO) << "Level " << level << " iteration " << it + 1 << "/"
+                   << options.iterations_per_level << ": similarity " << record.mean_similarity
+                   << ", step " << record.mean_step_px << " px (max " << record.max_step_px
+                   << "), " << record.regularizer_report << ", " << record.seconds << " s";
+      summary.iterations.push_back(record);
+    }
+  }
+
+  // Final photometric state at full resolution, and colours.
+  {
+    const std::vector<PinholeView> views = ScaledViews(source, 0);
+    RenderCache renders(renderer, views, cache_bytes / 2);
+    renderer->SetMesh(V, F);
+    MeshGeometry geometry{&V, &F, FaceNormals(V, F)};
+    SimilarityOptions plain = similarity;
+    plain.kappa = 0;
+    summary.final_similarity =
+        ComputeDataTerm(geometry, views, pairs, 0, plain, options.pair, &renders, &images)
+            .MeanSimilarity();
+  }
+  summary.initial_similarity =
+      summary.iterations.empty() ? summary.final_similarity : summary.iterations.front().mean_similarity;
+  // Leave no self-intersection behind (the flow can fold thin parts).
+  const SelfIntersectionReport intersections = CountSelfIntersections(V, F);
+  summary.self_intersections = static_cast<int>(intersections.intersecting_pairs);
+  if (intersections.intersecting_pairs > 0) {
+    const RemoveSelfIntersectionsSummary repair = RemoveSelfIntersections(&V, &F);
+    MR_LOG(INFO) << "Self-intersections: " << repair.BriefReport();
+    summary.self_intersections = static_cast<int>(repair.final_pairs);
+  }
+  mesh->V = V;
+  mesh->F = F;
+  mesh->N.resize(0, 3);
+  mesh->values.resize(0);
+  SampleVertexColors(source, V, F, renderer, &mesh->C);
+  summary.final_faces = mesh->NumFaces();
+  summary.final_vertices = mesh->NumVertices();
+  summary.termination = "FINISHED";
+  summary.seconds = ElapsedSeconds() - t_start;
+  return summary;
+}
+
+double PhotoConsistency(const ViewSource& source, const std::vector<int>& eval_views,
+                        const Eigen::MatrixXd& V, const Eigen::MatrixXi& F, Renderer* renderer,
+                        int num_neighbors) {
+  const std::vector<PinholeView> views = source.Views();
+  ViewSelectionOptions selection;
+  selection.num_neighbors = std::min(16, 2 * num_neighbors);
+  const auto neighbors = SelectNeighbors(views, V, VertexNormals(V, F), selection);
+  ImageCache images(source, size_t{512} << 20);
+  RenderCache renders(renderer, views, size_t{512} << 20);
+  renderer->SetMesh(V, F);
+  MeshGeometry geometry{&V, &F, FaceNormals(V, F)};
+  SimilarityOptions zncc;
+  zncc.method = "zncc";
+  PairTermOptions pair;
+  DataTerm term;
+  term.Reset(static_cast<int>(V.rows()));
+  const std::set<int> evaluated(eval_views.begin(), eval_views.end());
+  for (int i : eval_views) {
+    for (int j : neighbors.at(i)) {
+      if (evaluated.count(j)) continue;  // compare only against views that were used
+      AccumulatePairTerm(geometry, views[i], *renders.Get(i), images.Gray(i, 0), views[j],
+                         *renders.Get(j), images.Gray(j, 0), zncc, pair, &term);
+    }
+  }
+  return term.MeanSimilarity();
+}
+
+}  // namespace mr

@@ -1,0 +1,102 @@
+#pragma once
+
+// DCV refinement (Li et al., TIP 2016): a proximal-gradient loop that
+// alternates a reprojection-error gradient step (detail-preserving
+// similarity) and a content-aware L_p denoising step, coarse to fine.
+
+#include <string>
+#include <vector>
+
+#include "colmap_io/ply.h"
+#include "denoise/denoiser.h"
+#include "refine/photometric.h"
+#include "refine/similarity.h"
+#include "refine/view_selection.h"
+#include "refine/view_source.h"
+
+namespace mr {
+
+class Renderer;
+
+struct RefineOptions {
+  // Image pyramid levels (1 = full resolution only; 1..6).
+  int num_levels = 3;
+  // Gradient + denoising iterations at each level (>= 0).
+  int iterations_per_level = 10;
+  // Target triangle edge length in pixels at every level (> 0). The mesh is
+  // remeshed to it when a level starts.
+  double target_edge_px = 2.5;
+  // Upper bound on faces (>= 0; 0: 2x the input's faces, at least 100k).
+  int max_faces = 0;
+  // Fraction of the Gauss-Newton step taken per iteration, η (0 < step <= 1).
+  double step = 0.5;
+  // Largest vertex motion per iteration in pixel footprints of the current
+  // level (> 0).
+  double max_step_px = 1.0;
+  // Levenberg damping of the curvature, relative to its median (>= 0).
+  double damping = 0.1;
+  // Similarity: "dcv" (detail-preserving, the paper's) or "zncc".
+  std::string similarity = "dcv";
+  // Final κ of the detail-preserving term; κ grows linearly from
+  // kappa / (total iterations) to kappa over the run (>= 0).
+  double kappa = 0.5;
+  // Regulariser of the proximal step: "lp" (content-aware L_p, the paper's),
+  // "laplacian" (1st+2nd order), or "none".
+  std::string regularizer = "lp";
+  // Weight of the silhouette (horizon) term when masks exist (>= 0; 0 = off).
+  double silhouette_weight = 1.0;
+  // Memory budget for cached images and renders, in MB (>= 64).
+  int cache_mb = 1024;
+
+  ViewSelectionOptions view_selection;
+  SimilarityOptions similarity_options;
+  PairTermOptions pair;
+  DenoiseOptions denoise;
+
+  bool Check() const;
+};
+
+struct RefineIteration {
+  int level = 0;
+  int iteration = 0;
+  int faces = 0;
+  double mean_similarity = 0;  // before the step, over all valid pair pixels
+  double kappa = 0;
+  double mean_step_px = 0;     // mean |gradient step| in pixel footprints
+  double max_step_px = 0;
+  std::string regularizer_report;  // e.g. "p=0.5 theta=... sigma=... lambda=..."
+  double seconds = 0;
+};
+
+struct RefineSummary {
+  std::string termination;  // "FINISHED" or why it stopped
+  int num_views = 0;
+  int num_pairs = 0;
+  int initial_faces = 0, final_faces = 0;
+  int initial_vertices = 0, final_vertices = 0;
+  double initial_similarity = 0;  // mean similarity at full resolution before
+  double final_similarity = 0;    // and after refinement
+  int flipped_faces_fixed = 0;
+  int self_intersections = -1;    // of the result (-1: not computed)
+  double seconds = 0;
+  std::vector<RefineIteration> iterations;
+
+  std::string BriefReport() const;
+  std::string FullReport() const;
+};
+
+// Refines `mesh` in place (positions, connectivity, vertex colours) against
+// the views of `source`. Throws InputError if the mesh is empty, no face is
+// visible in any view, or no two views overlap. `renderer` may be null (one
+// is created).
+RefineSummary RefineMesh(const ViewSource& source, const RefineOptions& options,
+                         TriangleMesh* mesh, Renderer* renderer = nullptr);
+
+// Mean similarity (plain ZNCC) of the predicted images of `eval_views`
+// against their neighbours among `source`'s other views, through `mesh`:
+// a photo-consistency score that needs no ground truth (held-out views).
+double PhotoConsistency(const ViewSource& source, const std::vector<int>& eval_views,
+                        const Eigen::MatrixXd& V, const Eigen::MatrixXi& F, Renderer* renderer,
+                        int num_neighbors = 3);
+
+}  // namespace mr

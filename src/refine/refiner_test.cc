@@ -1,0 +1,162 @@
+#include <gtest/gtest.h>
+
+#include <random>
+
+#include "eval/evaluator.h"
+#include "geometry/mesh.h"
+#include "geometry/primitives.h"
+#include "refine/photometric.h"
+#include "refine/refiner.h"
+#include "refine/test_scene.h"
+#include "render/renderer.h"
+#include "util/error.h"
+
+namespace mr {
+namespace {
+
+class RefinerTest : public ::testing::Test {
+ protected:
+  static void SetUpTestSuite() { renderer_ = new Renderer(); }
+  static void TearDownTestSuite() {
+    delete renderer_;
+    renderer_ = nullptr;
+  }
+  static RefineOptions FastOptions() {
+    RefineOptions options;
+    options.num_levels = 2;
+    options.iterations_per_level = 6;
+    options.target_edge_px = 3.0;
+    return options;
+  }
+  static Renderer* renderer_;
+};
+Renderer* RefinerTest::renderer_ = nullptr;
+
+EvaluationResult Evaluate(const Eigen::MatrixXd& V, const Eigen::MatrixXi& F,
+                          const Eigen::MatrixXd& gV, const Eigen::MatrixXi& gF) {
+  EvaluationOptions options;
+  options.threshold = 0.02;
+  options.num_samples = 20000;
+  return EvaluateMesh(V, F, gV, gF, options);
+}
+
+TEST_F(RefinerTest, GroundTruthStaysGroundTruth) {
+  Eigen::MatrixXd V;
+  Eigen::MatrixXi F;
+  MakeBumpySphere(5, 0.06, &V, &F);
+  const InMemoryViewSource source = MakeTestScene(V, F, {}, {}, renderer_);
+  TriangleMesh mesh;
+  mesh.V = V;
+  mesh.F = F;
+  const RefineSummary summary = RefineMesh(source, FastOptions(), &mesh, renderer_);
+  const EvaluationResult after = Evaluate(mesh.V, mesh.F, V, F);
+  // Remeshing a curved surface costs a little accuracy (chords); the flow
+  // must not add more than a fraction of a pixel footprint (~0.018 here).
+  EXPECT_LT(after.accuracy90, 0.006) << summary.FullReport();
+  EXPECT_GT(summary.final_similarity, 0.8) << summary.FullReport();
+}
+
+TEST_F(RefinerTest, NoisyMeshGetsCloserToGroundTruth) {
+  Eigen::MatrixXd V;
+  Eigen::MatrixXi F;
+  MakeBumpySphere(5, 0.06, &V, &F);
+  const InMemoryViewSource source = MakeTestScene(V, F, {}, {}, renderer_);
+  // Start from a smooth sphere: the relief must be recovered from the images.
+  Eigen::MatrixXd V0;
+  Eigen::MatrixXi F0;
+  MakeIcosphere(4, 1.0, &V0, &F0);
+  TriangleMesh mesh;
+  mesh.V = V0;
+  mesh.F = F0;
+  const EvaluationResult before = Evaluate(V0, F0, V, F);
+  const RefineSummary summary = RefineMesh(source, FastOptions(), &mesh, renderer_);
+  const EvaluationResult after = Evaluate(mesh.V, mesh.F, V, F);
+  EXPECT_LT(after.accuracy90, 0.6 * before.accuracy90) << summary.FullReport();
+  EXPECT_LT(after.normal_deg, before.normal_deg) << summary.FullReport();
+  EXPECT_GT(summary.final_similarity, summary.initial_similarity);
+}
+
+TEST_F(RefinerTest, InvariantToRotationAndScale) {
+  Eigen::MatrixXd V;
+  Eigen::MatrixXi F;
+  MakeBumpySphere(5, 0.06, &V, &F);
+  Eigen::MatrixXd V0;
+  Eigen::MatrixXi F0;
+  MakeIcosphere(4, 1.0, &V0, &F0);
+  RefineOptions options = FastOptions();
+  options.num_levels = 1;
+  options.iterations_per_level = 4;
+
+  TriangleMesh plain;
+  plain.V = V0;
+  plain.F = F0;
+  RefineMesh(MakeTestScene(V, F, {}, {}, renderer_), options, &plain, renderer_);
+
+  SceneTransform moved;
+  moved.scale = 37.0;
+  moved.rotation = Eigen::AngleAxisd(0.7, Eigen::Vector3d(1, 2, 3).normalized()).toRotationMatrix();
+  moved.translation = Eigen::Vector3d(100, -20, 5);
+  TriangleMesh transformed;
+  transformed.V = moved.Apply(V0);
+  transformed.F = F0;
+  RefineMesh(MakeTestScene(V, F, {}, moved, renderer_), options, &transformed, renderer_);
+
+  // Compare in the canonical frame, as surfaces (remeshing may pick different
+  // vertices after floating-point differences).
+  Eigen::MatrixXd back(transformed.V.rows(), 3);
+  for (int i = 0; i < back.rows(); ++i) back.row(i) = moved.Inverse(transformed.V.row(i)).transpose();
+  const EvaluationResult diff = Evaluate(back, transformed.F, plain.V, plain.F);
+  EXPECT_LT(diff.accuracy90, 1e-3);
+}
+
+TEST_F(RefinerTest, EmptyMeshIsRefused) {
+  Eigen::MatrixXd V;
+  Eigen::MatrixXi F;
+  MakeBumpySphere(3, 0.06, &V, &F);
+  const InMemoryViewSource source = MakeTestScene(V, F, {}, {}, renderer_);
+  TriangleMesh empty;
+  empty.V.resize(0, 3);
+  empty.F.resize(0, 3);
+  EXPECT_THROW(RefineMesh(source, FastOptions(), &empty, renderer_), InputError);
+}
+
+TEST_F(RefinerTest, MeshBehindCamerasIsRefused) {
+  Eigen::MatrixXd V;
+  Eigen::MatrixXi F;
+  MakeBumpySphere(3, 0.06, &V, &F);
+  const InMemoryViewSource source = MakeTestScene(V, F, {}, {}, renderer_);
+  TriangleMesh far_away;
+  far_away.V = V.rowwise() + Eigen::RowVector3d(0, 0, 1000);
+  far_away.F = F;
+  EXPECT_THROW(RefineMesh(source, FastOptions(), &far_away, renderer_), InputError);
+}
+
+TEST_F(RefinerTest, ViewsWithoutOverlapAreRefused) {
+  Eigen::MatrixXd V;
+  Eigen::MatrixXi F;
+  MakeBumpySphere(3, 0.06, &V, &F);
+  TestSceneOptions opposite;
+  opposite.num_views = 2;  // two cameras on opposite sides see disjoint halves
+  opposite.elevation_deg = 0;
+  const InMemoryViewSource source = MakeTestScene(V, F, opposite, {}, renderer_);
+  TriangleMesh mesh;
+  mesh.V = V;
+  mesh.F = F;
+  EXPECT_THROW(RefineMesh(source, FastOptions(), &mesh, renderer_), InputError);
+}
+
+TEST(RefineOptions, DefaultsAreValid) { EXPECT_TRUE(RefineOptions().Check()); }
+
+TEST(RefineOptions, BadValuesNameTheField) {
+  RefineOptions options;
+  options.similarity = "ssd";
+  try {
+    options.Check();
+    FAIL() << "expected InputError";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("similarity"), std::string::npos);
+  }
+}
+
+}  // namespace
+}  // namespace mr

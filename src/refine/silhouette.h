@@ -1,0 +1,32 @@
+#pragma once
+
+// The horizon (silhouette) term, used when masks exist. The paper's
+// M_horiz (eq. evolution_eq_horiz) moves contour generators so that the
+// rendered silhouette matches the observed one against a black background.
+// We use its geometric form: a vertex on the occluding contour of view i
+// that projects at signed distance s (pixels, positive inside the mask) from
+// the mask boundary is pulled by s pixel footprints along the image-plane
+// component of its normal (outward when s > 0, inward when s < 0).
+
+#include <opencv2/core.hpp>
+
+#include <Eigen/Core>
+
+#include "geometry/view.h"
+#include "render/renderer.h"
+
+namespace mr {
+
+// Signed distance to the mask boundary in pixels (CV_32F; > 0 inside).
+cv::Mat SignedDistanceToMask(const cv::Mat& mask);
+
+// Adds, for each contour vertex of `view`, its desired displacement (world
+// units) to `displacement` (#V by 3) and 1 to `count` (#V). Distances are
+// capped at `max_px` pixels.
+void AccumulateSilhouetteTerm(const Eigen::MatrixXd& V, const Eigen::MatrixXi& F,
+                              const Eigen::MatrixXd& vertex_normals, const PinholeView& view,
+                              const RenderBuffers& render, const cv::Mat& signed_distance,
+                              double max_px, Eigen::MatrixXd* displacement,
+                              Eigen::VectorXd* count);
+
+}  // namespace mr

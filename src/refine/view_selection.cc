@@ -1,0 +1,121 @@
+#include "refine/view_selection.h"
+
+#include <algorithm>
+#include <cmath>
+#include <set>
+
+#include "util/error.h"
+
+namespace mr {
+
+bool ViewSelectionOptions::Check() const {
+  if (num_neighbors < 1 || num_neighbors > 16) {
+    MR_THROW_INPUT << "ViewSelectionOptions::num_neighbors = " << num_neighbors
+                   << ". Violated constraint: 1 <= num_neighbors <= 16";
+  }
+  if (!(0 < min_angle_deg && min_angle_deg < ideal_angle_deg && ideal_angle_deg < max_angle_deg &&
+        max_angle_deg < 90)) {
+    MR_THROW_INPUT << "ViewSelectionOptions angles = " << min_angle_deg << ", " << ideal_angle_deg
+                   << ", " << max_angle_deg
+                   << ". Violated constraint: 0 < min_angle_deg < ideal_angle_deg < "
+                      "max_angle_deg < 90";
+  }
+  if (!(min_overlap >= 0 && min_overlap <= 1)) {
+    MR_THROW_INPUT << "ViewSelectionOptions::min_overlap = " << min_overlap
+                   << ". Violated constraint: 0 <= min_overlap <= 1";
+  }
+  return true;
+}
+
+std::vector<std::vector<int>> SelectNeighbors(const std::vector<PinholeView>& views,
+                                              const Eigen::MatrixXd& V,
+                                              const Eigen::MatrixXd& N,
+                                              const ViewSelectionOptions& options) {
+  options.Check();
+  const int num_views = static_cast<int>(views.size());
+  // Up to ~4000 evenly strided vertex samples keep this cheap for any mesh.
+  const int stride = std::max<int>(1, static_cast<int>(V.rows() / 4000));
+  std::vector<int> samples;
+  for (int v = 0; v < V.rows(); v += stride) samples.push_back(v);
+
+  // seen[i][s]: sample s faces camera i and projects inside image i.
+  std::vector<std::vector<char>> seen(num_views, std::vector<char>(samples.size(), 0));
+  for (int i = 0; i < num_views; ++i) {
+    const Eigen::Vector3d c = views[i].Center();
+    for (size_t s = 0; s < samples.size(); ++s) {
+      const Eigen::Vector3d x = V.row(samples[s]);
+      const Eigen::Vector3d xc = views[i].WorldToCamera(x);
+      if (xc.z() <= 0) continue;
+      if (N.rows() == V.rows() && N.row(samples[s]).dot(c - x) <= 0) continue;
+      if (views[i].InImage(views[i].CameraToImage(xc))) seen[i][s] = 1;
+    }
+  }
+
+  const double deg = M_PI / 180.0;
+  std::vector<std::vector<int>> neighbors(num_views);
+  for (int i = 0; i < num_views; ++i) {
+    const long num_seen = std::count(seen[i].begin(), seen[i].end(), 1);
+    if (num_seen == 0) continue;
+    std::vector<std::pair<double, int>> scored;
+    for (int j = 0; j < num_views; ++j) {
+      if (j == i) continue;
+      double score = 0;
+      long shared = 0;
+      for (size_t s = 0; s < samples.size(); ++s) {
+        if (!seen[i][s] || !seen[j][s]) continue;
+        ++shared;
+        const Eigen::Vector3d x = V.row(samples[s]);
+        const Eigen::Vector3d a = (views[i].Center() - x).normalized();
+        const Eigen::Vector3d b = (views[j].Center() - x).normalized();
+        const double angle = std::acos(std::clamp(a.dot(b), -1.0, 1.0)) / deg;
+        if (angle < options.min_angle_deg || angle > options.max_angle_deg) continue;
+        // A Gaussian preference around the ideal angle, wider on the large side.
+        const double width = angle < options.ideal_angle_deg
+                                 ? options.ideal_angle_deg - options.min_angle_deg
+                                 : options.max_angle_deg - options.ideal_angle_deg;
+        const double d = (angle - options.ideal_angle_deg) / width;
+        score += std::exp(-2.0 * d * d);
+      }
+      if (shared < options.min_overlap * num_seen || score <= 0) continue;
+      scored.emplace_back(score, j);
+    }
+    std::sort(scored.begin(), scored.end(), [](const auto& a, const auto& b) {
+      return a.first != b.first ? a.first > b.first : a.second < b.second;
+    });
+    for (int k = 0; k < std::min<int>(options.num_neighbors, static_cast<int>(scored.size())); ++k) {
+      neighbors[i].push_back(scored[k].second);
+    }
+  }
+  return neighbors;
+}
+
+// Median pixel footprint (world units per pixel) of the mesh vertices over
+// the views that see them (facing the camera, inside the image).
+double MedianFootprint(const std::vector<PinholeView>& views, const Eigen::MatrixXd& V,
+                       const Eigen::MatrixXd& N) {
+  std::vector<double> footprints;
+  const int stride = std::max<int>(1, static_cast<int>(V.rows() / 5000));
+  for (int v = 0; v < V.rows(); v += stride) {
+    const Eigen::Vector3d x = V.row(v);
+    for (const auto& view : views) {
+      const Eigen::Vector3d xc = view.WorldToCamera(x);
+      if (xc.z() <= 0 || N.row(v).dot(view.Center() - x) <= 0) continue;
+      if (!view.InImage(view.CameraToImage(xc))) continue;
+      footprints.push_back(xc.z() / view.fx);
+    }
+  }
+  if (footprints.empty()) return 0;
+  std::nth_element(footprints.begin(), footprints.begin() + footprints.size() / 2,
+                   footprints.end());
+  return footprints[footprints.size() / 2];
+}
+
+std::vector<std::pair<int, int>> NeighborPairs(const std::vector<std::vector<int>>& neighbors) {
+  std::set<std::pair<int, int>> pairs;
+  for (int i = 0; i < static_cast<int>(neighbors.size()); ++i) {
+    for (int j : neighbors[i]) pairs.emplace(std::min(i, j), std::max(i, j));
+  }
+  return {pairs.begin(), pairs.end()};
+}
+
+}  // namespace mr

@@ -1,0 +1,46 @@
+#pragma once
+
+// Choice of neighbouring views for the reprojection error: for every view,
+// the views that see the same part of the surface from a useful baseline.
+
+#include <utility>
+#include <vector>
+
+#include <Eigen/Core>
+
+#include "geometry/view.h"
+
+namespace mr {
+
+struct ViewSelectionOptions {
+  // Neighbours per view (1..16). Pairs are used both ways.
+  int num_neighbors = 3;
+  // Preferred angle in degrees between the two viewing rays to a surface
+  // point (0 < min < ideal < max < 90).
+  double min_angle_deg = 3.0;
+  double ideal_angle_deg = 20.0;
+  double max_angle_deg = 60.0;
+  // Minimum fraction (0..1) of the reference view's visible samples that the
+  // neighbour must also see.
+  double min_overlap = 0.1;
+  bool Check() const;
+};
+
+// For each view i, its selected neighbours, best first. Scores use sampled
+// mesh vertices that face both cameras and project inside both images
+// (occlusion is not tested). Views with no acceptable neighbour get none.
+std::vector<std::vector<int>> SelectNeighbors(const std::vector<PinholeView>& views,
+                                              const Eigen::MatrixXd& V,
+                                              const Eigen::MatrixXd& N,
+                                              const ViewSelectionOptions& options);
+
+// Unordered pairs {i, j} (i < j) from the neighbour lists, sorted.
+std::vector<std::pair<int, int>> NeighborPairs(const std::vector<std::vector<int>>& neighbors);
+
+// Median pixel footprint (world units per pixel) of the vertices V (with
+// normals N) over the views that see them (facing the camera, inside the
+// image); 0 if no view sees any vertex.
+double MedianFootprint(const std::vector<PinholeView>& views, const Eigen::MatrixXd& V,
+                       const Eigen::MatrixXd& N);
+
+}  // namespace mr

@@ -1,0 +1,100 @@
+#pragma once
+
+// Where the refiner gets its views and images. Images are loaded on demand
+// and kept in a bounded cache, so memory does not grow with the number of
+// views times pixels.
+
+#include <list>
+#include <map>
+#include <memory>
+#include <set>
+#include <string>
+#include <vector>
+
+#include <opencv2/core.hpp>
+
+#include "colmap_io/workspace.h"
+#include "geometry/view.h"
+
+namespace mr {
+
+class ViewSource {
+ public:
+  virtual ~ViewSource() = default;
+  virtual int NumViews() const = 0;
+  // The view at full resolution.
+  virtual const PinholeView& View(int i) const = 0;
+  virtual std::string Name(int i) const = 0;
+  // Grayscale CV_32F in [0, 1] at full resolution.
+  virtual cv::Mat LoadGray(int i) const = 0;
+  // BGR CV_8UC3 at full resolution (for vertex colours).
+  virtual cv::Mat LoadColor(int i) const = 0;
+  // CV_8U mask (nonzero = object) at full resolution, or empty if none.
+  virtual cv::Mat LoadMask(int i) const { return {}; }
+  virtual bool HasMasks() const { return false; }
+
+  std::vector<PinholeView> Views() const;
+};
+
+// The registered images of a COLMAP workspace, minus `excluded` names
+// (held-out views).
+class WorkspaceViewSource : public ViewSource {
+ public:
+  explicit WorkspaceViewSource(const Workspace& workspace,
+                               const std::set<std::string>& excluded = {});
+  int NumViews() const override { return static_cast<int>(ids_.size()); }
+  const PinholeView& View(int i) const override { return views_.at(i); }
+  std::string Name(int i) const override;
+  cv::Mat LoadGray(int i) const override;
+  cv::Mat LoadColor(int i) const override;
+  cv::Mat LoadMask(int i) const override;
+  bool HasMasks() const override { return !workspace_.mask_dir.empty(); }
+
+ private:
+  const Workspace& workspace_;
+  std::vector<uint32_t> ids_;
+  std::vector<PinholeView> views_;
+};
+
+// Views and images held in memory (tests, synthetic scenes).
+class InMemoryViewSource : public ViewSource {
+ public:
+  void Add(const std::string& name, const PinholeView& view, const cv::Mat& gray,
+           const cv::Mat& mask = {});
+  int NumViews() const override { return static_cast<int>(views_.size()); }
+  const PinholeView& View(int i) const override { return views_.at(i); }
+  std::string Name(int i) const override { return names_.at(i); }
+  cv::Mat LoadGray(int i) const override { return grays_.at(i); }
+  cv::Mat LoadColor(int i) const override;
+  cv::Mat LoadMask(int i) const override { return masks_.at(i); }
+  bool HasMasks() const override;
+
+ private:
+  std::vector<std::string> names_;
+  std::vector<PinholeView> views_;
+  std::vector<cv::Mat> grays_, masks_;
+};
+
+// A least-recently-used cache of per-view pyramid levels of a ViewSource,
+// bounded in bytes.
+class ImageCache {
+ public:
+  ImageCache(const ViewSource& source, size_t max_bytes);
+  // Grayscale CV_32F image of view i at pyramid level `level` (0 = full).
+  // The returned header shares data with the cache entry (cheap copy) and
+  // stays valid after the entry is evicted.
+  cv::Mat Gray(int i, int level);
+  // Mask (CV_8U) of view i at `level`, or an empty Mat.
+  cv::Mat Mask(int i, int level);
+
+ private:
+  cv::Mat Get(int kind, int i, int level);
+  const ViewSource& source_;
+  size_t max_bytes_;
+  size_t bytes_ = 0;
+  using Key = std::tuple<int, int, int>;  // kind, view, level
+  std::list<std::pair<Key, cv::Mat>> entries_;  // most recent first
+  std::map<Key, std::list<std::pair<Key, cv::Mat>>::iterator> index_;
+};
+
+}  // namespace mr
