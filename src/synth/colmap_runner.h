@@ -17,10 +17,12 @@ struct ColmapRunOptions {
   // small cloud; if the mesh comes out empty the run is retried with lower
   // trims (logged). Range [0, 20].
   double poisson_trim = 5;
-  // --PoissonMeshing.depth (octree depth). COLMAP's default is 13; for the
-  // default workspace depths 10-13 give the same mesh (the point density
-  // limits it) but 13 takes longer. Range [4, 16].
-  int poisson_depth = 10;
+  // --PoissonMeshing.depth (octree depth). COLMAP's default is 13. On the
+  // default workspace (~85k fused points) depths 8 to 13 gave meshes of
+  // 300k-370k faces with the same accuracy (mean distance to the ground truth
+  // 0.093 vs 0.096 units), but the solve took 29 s at depth 8 and 124-158 s
+  // at depths 9-10 on a shared 2-core machine. Range [4, 16].
+  int poisson_depth = 8;
   // Threads for both stages (-1: all). Range -1 or >= 1.
   int num_threads = -1;
 

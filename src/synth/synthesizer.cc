@@ -168,7 +168,6 @@ SynthesizerSummary SynthesizeWorkspace(const SynthesizerOptions& options) {
   Renderer renderer(options.renderer);
   summary.renderer = renderer.Description();
   renderer.SetMesh(scene.V, scene.F);
-  MR_LOG(INFO) << "Renderer: " << summary.renderer;
   std::vector<std::string> names;
   std::vector<SynthImage> images;
   std::vector<RenderBuffers> exact;

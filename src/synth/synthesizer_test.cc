@@ -13,6 +13,7 @@
 
 #include "colmap_io/dense_array.h"
 #include "colmap_io/ply.h"
+#include "colmap_io/sparse_model.h"
 #include "synth/synth_test_util.h"
 #include "util/error.h"
 #include "util/file.h"
@@ -91,6 +92,25 @@ TEST(Synthesizer, WritesWorkspaceAndGroundTruthBesideIt) {
   }
   EXPECT_EQ(ReadFileToString(JoinPaths(dense, "stereo/fusion.cfg")), fusion_cfg);
   EXPECT_EQ(ReadFileToString(JoinPaths(dense, "stereo/patch-match.cfg")), patch_cfg);
+
+  // The sparse model reads back (COLMAP's binary layout) and its tracks
+  // reproject onto their points2D.
+  const Reconstruction model = ReadSparseModelBinary(JoinPaths(dense, "sparse"));
+  ASSERT_EQ(model.cameras.size(), 1u);
+  ASSERT_EQ(model.images.size(), 6u);
+  EXPECT_EQ(static_cast<int>(model.points3D.size()), summary.num_points3D);
+  EXPECT_EQ(model.cameras.begin()->second.model, CameraModel::kPinhole);
+  for (const auto& [id, point] : model.points3D) {
+    ASSERT_GE(point.track.size(), 2u);
+    for (const TrackElement& el : point.track) {
+      const Image& image = model.images.at(el.image_id);
+      const PinholeView view = ViewFromColmap(model.cameras.at(image.camera_id), image);
+      ASSERT_LT(el.point2D_idx, image.points2D.size());
+      EXPECT_EQ(image.points2D[el.point2D_idx].point3D_id, static_cast<int64_t>(id));
+      EXPECT_LT((view.Project(point.xyz) - image.points2D[el.point2D_idx].xy).norm(), 0.5);
+    }
+  }
+  EXPECT_EQ(model.images.at(1).name, "view_0000.png");
 
   // Ground truth normalised: diagonal 100, centred.
   const TriangleMesh gt = ReadPly(JoinPaths(dir, "ground_truth.ply"));
