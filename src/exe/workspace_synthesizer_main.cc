@@ -27,6 +27,8 @@ int main(int argc, char** argv) {
     options.AddRequired("output_path", &o.output_path, "output folder (DIR/dense must not exist)");
     options.Add("model_path", &o.model_path,
                 "ground-truth mesh (.ply/.obj); empty: the built-in shape");
+    options.Add("model_up_axis", &o.model_up_axis,
+                "axis of the model that points up: x, y or z (the bunny: y)");
     options.Add("shape", &o.shape, "built-in shape when no model_path: builtin");
     options.Add("scene_diagonal", &o.scene_diagonal,
                 "bounding-box diagonal of the normalised ground truth (scene units)");

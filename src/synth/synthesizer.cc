@@ -41,6 +41,14 @@ TriangleMesh LoadGroundTruth(const SynthesizerOptions& options) {
       MR_THROW_INPUT << options.model_path << ": ground-truth mesh has no faces";
     }
     RemoveUnreferencedVertices(&mesh.V, &mesh.F);
+    // Rotate the up axis onto +z (proper rotations, so faces keep their orientation).
+    Eigen::Matrix3d R = Eigen::Matrix3d::Identity();
+    if (options.model_up_axis == "y") {
+      R << 1, 0, 0, 0, 0, -1, 0, 1, 0;  // y -> z, z -> -y
+    } else if (options.model_up_axis == "x") {
+      R << 0, 0, -1, 0, 1, 0, 1, 0, 0;  // x -> z, z -> -x
+    }
+    mesh.V = (mesh.V * R.transpose()).eval();
   } else {
     mesh = MakeBuiltinShape(options.builtin);
   }
@@ -60,6 +68,10 @@ bool SynthesizerOptions::Check() const {
   if (model_path.empty() && shape != "builtin") {
     MR_THROW_INPUT << "SynthesizerOptions::shape = " << shape
                    << ". Violated constraint: shape is builtin (or give model_path)";
+  }
+  if (model_up_axis != "x" && model_up_axis != "y" && model_up_axis != "z") {
+    MR_THROW_INPUT << "SynthesizerOptions::model_up_axis = " << model_up_axis
+                   << ". Violated constraint: model_up_axis is x, y or z";
   }
   if (!(scene_diagonal > 0 && scene_diagonal <= 1e6)) {
     MR_THROW_INPUT << "SynthesizerOptions::scene_diagonal = " << scene_diagonal

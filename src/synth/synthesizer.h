@@ -28,6 +28,10 @@ struct SynthesizerOptions {
   std::string output_path;
   // Ground-truth mesh (.ply or .obj); empty: the built-in `shape`.
   std::string model_path;
+  // Axis of the loaded model that points up ("x", "y" or "z"); it is rotated
+  // onto the world +z axis that the cameras treat as up. Scanned models such
+  // as the Stanford bunny are often "y".
+  std::string model_up_axis = "z";
   // Built-in shape when model_path is empty: "builtin".
   std::string shape = "builtin";
   // Bounding-box diagonal of the normalised ground truth (scene units). (0, 1e6].

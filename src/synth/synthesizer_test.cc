@@ -180,6 +180,31 @@ TEST(Synthesizer, LoadsObjModelAndNormalisesIt) {
   EXPECT_GT(summary.mean_coverage, 0.05);
 }
 
+TEST(Synthesizer, ModelUpAxisIsRotatedOntoZ) {
+  const std::string dir = FreshDir("upaxis");
+  CreateDirIfNotExists(dir);
+  // A tetrahedron elongated along y (10 units) and 2 units across otherwise.
+  const std::string obj = JoinPaths(dir, "rod.obj");
+  {
+    std::ofstream out(obj);
+    out << "v 0 0 0\nv 2 0 0\nv 1 0 2\nv 1 10 1\nf 1 3 2\nf 1 2 4\nf 2 3 4\nf 3 1 4\n";
+  }
+  for (const std::string axis : {"y", "z"}) {
+    SynthesizerOptions options = SmallOptions(JoinPaths(dir, "out_" + axis));
+    options.model_path = obj;
+    options.model_up_axis = axis;
+    SynthesizeWorkspace(options);
+    const TriangleMesh gt = ReadPly(JoinPaths(options.output_path, "ground_truth.ply"));
+    const Eigen::RowVector3d extent = gt.V.colwise().maxCoeff() - gt.V.colwise().minCoeff();
+    Eigen::Index longest = 0;
+    extent.maxCoeff(&longest);
+    EXPECT_EQ(longest, axis == "y" ? 2 : 1) << "up axis " << axis;
+  }
+  SynthesizerOptions bad = SmallOptions(JoinPaths(dir, "bad"));
+  bad.model_up_axis = "w";
+  EXPECT_THROW(bad.Check(), InputError);
+}
+
 TEST(ColmapRunner, HelpersAndFailureMessage) {
   EXPECT_FALSE(FindExecutable("sh").empty());
   EXPECT_TRUE(FindExecutable("no_such_program_mr_synth").empty());
