@@ -127,6 +127,24 @@ DataTerm ComputeDataTerm(const MeshGeometry& mesh, const std::vector<PinholeView
   return term;
 }
 
+// Mean plain-ZNCC similarity of all pairs at full resolution through (V, F).
+double FullResolutionSimilarity(const ViewSource& source,
+                                const std::vector<std::pair<int, int>>& pairs,
+                                const SimilarityOptions& similarity,
+                                const PairTermOptions& pair_options, const Eigen::MatrixXd& V,
+                                const Eigen::MatrixXi& F, Renderer* renderer, size_t cache_bytes,
+                                ImageCache* images) {
+  const std::vector<PinholeView> views = source.Views();
+  RenderCache renders(renderer, views, cache_bytes);
+  renderer->SetMesh(V, F);
+  MeshGeometry geometry{&V, &F, FaceNormals(V, F)};
+  SimilarityOptions plain = similarity;
+  plain.method = "zncc";
+  plain.kappa = 0;
+  return ComputeDataTerm(geometry, views, pairs, 0, plain, pair_options, &renders, images)
+      .MeanSimilarity();
+}
+
 // Per-vertex colours: the mean colour of each vertex over the views where
 // it is visible, weighted by the cosine of the viewing angle.
 void SampleVertexColors(const ViewSource& source, const Eigen::MatrixXd& V,
@@ -280,6 +298,10 @@ RefineSummary RefineMesh(const ViewSource& source, const RefineOptions& options,
   DenoiseOptions denoise = options.denoise;
   denoise.method = options.regularizer == "laplacian" ? "laplacian" : "lp";
 
+  summary.initial_similarity = FullResolutionSimilarity(source, pairs, similarity, options.pair, V,
+                                                        F, renderer, cache_bytes / 2, &images);
+  MR_LOG(INFO) << "Initial mean similarity (ZNCC, full resolution): "
+               << summary.initial_similarity;
   const int total_iterations = options.num_levels * options.iterations_per_level;
   int global_iteration = 0;
   for (int level = options.num_levels - 1; level >= 0; --level) {
@@ -368,20 +390,6 @@ RefineSummary RefineMesh(const ViewSource& source, const RefineOptions& options,
     }
   }
 
-  // Final photometric state at full resolution, and colours.
-  {
-    const std::vector<PinholeView> views = ScaledViews(source, 0);
-    RenderCache renders(renderer, views, cache_bytes / 2);
-    renderer->SetMesh(V, F);
-    MeshGeometry geometry{&V, &F, FaceNormals(V, F)};
-    SimilarityOptions plain = similarity;
-    plain.kappa = 0;
-    summary.final_similarity =
-        ComputeDataTerm(geometry, views, pairs, 0, plain, options.pair, &renders, &images)
-            .MeanSimilarity();
-  }
-  summary.initial_similarity =
-      summary.iterations.empty() ? summary.final_similarity : summary.iterations.front().mean_similarity;
   // Leave no self-intersection behind (the flow can fold thin parts).
   const SelfIntersectionReport intersections = CountSelfIntersections(V, F);
   summary.self_intersections = static_cast<int>(intersections.intersecting_pairs);
@@ -390,6 +398,8 @@ RefineSummary RefineMesh(const ViewSource& source, const RefineOptions& options,
     MR_LOG(INFO) << "Self-intersections: " << repair.BriefReport();
     summary.self_intersections = static_cast<int>(repair.final_pairs);
   }
+  summary.final_similarity = FullResolutionSimilarity(source, pairs, similarity, options.pair, V, F,
+                                                      renderer, cache_bytes / 2, &images);
   mesh->V = V;
   mesh->F = F;
   mesh->N.resize(0, 3);

