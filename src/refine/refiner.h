@@ -23,10 +23,14 @@ class Renderer;
 // method with one estimation round and a faster penalty continuation (x4).
 // One gradient step adds little noise, so this removes it at a third of the
 // cost of the standalone defaults, with the same accuracy on the test scene.
+// For the Laplacian baseline (--Refine.regularizer laplacian) the proximal
+// step is one first+second order smoothing pass per iteration, the explicit
+// form of the proximal operator of a quadratic smoothness energy.
 inline DenoiseOptions ProximalDenoiseOptions() {
   DenoiseOptions options;
   options.max_iterations = 1;
   options.beta_factor = 4.0;
+  options.laplacian_iterations = 1;
   return options;
 }
 
