@@ -82,7 +82,7 @@ class Metric {
 };
 
 // Experiment-only overrides of the lp options from the environment (MAXIT,
-// FIXP, LSCALE, BMAX, B0, FIXL, BF, UPDOP); unset = defaults. Results in docs/ use none.
+// FIXP, LSCALE, BMAX, B0, FIXL, BF, UPDOP, ESTIT, INNER); unset = defaults. Results in docs/ use none.
 void ApplyEnvOverrides(mr::DenoiseOptions* o) {
   auto env = [](const char* name, double fallback) {
     const char* v = std::getenv(name);
@@ -95,6 +95,8 @@ void ApplyEnvOverrides(mr::DenoiseOptions* o) {
   o->beta_initial = env("B0", o->beta_initial);
   o->fixed_lambda = env("FIXL", o->fixed_lambda);
   o->beta_factor = env("BF", o->beta_factor);
+  o->estimate_iterations = static_cast<int>(env("ESTIT", o->estimate_iterations));
+  o->inner_iterations = static_cast<int>(env("INNER", o->inner_iterations));
   o->update_operator = env("UPDOP", o->update_operator ? 1 : 0) != 0;
 }
 
