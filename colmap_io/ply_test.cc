@@ -414,7 +414,7 @@ TEST(Ply, ColmapPoissonMesher) {
             std::string::npos);
   const std::string command = "QT_QPA_PLATFORM=offscreen '" + colmap +
                               "' poisson_mesher --input_path '" + in + "' --output_path '" + out +
-                              "' --PoissonMeshing.trim 5 > '" + TempPath("colmap.log") + "' 2>&1";
+                              "' --PoissonMeshing.trim 5 --PoissonMeshing.depth 8 > '" + TempPath("colmap.log") + "' 2>&1";
   ASSERT_EQ(std::system(command.c_str()), 0) << command << "\n" << ReadRaw(TempPath("colmap.log"));
   const TriangleMesh mesh = ReadPly(out);
   ASSERT_GT(mesh.NumFaces(), 100);

@@ -7,6 +7,7 @@
 
 #include <algorithm>
 #include <cstdio>
+#include <filesystem>
 #include <fstream>
 #include <iostream>
 #include <set>
@@ -36,34 +37,6 @@ std::set<std::string> ReadNameList(const std::string& path) {
     names.insert(line.substr(b, line.find_last_not_of(" \t\r") - b + 1));
   }
   return names;
-}
-
-void RegisterRefineOptions(OptionManager* o, RefineOptions* r) {
-  o->Add("Refine.num_levels", &r->num_levels, "image pyramid levels, coarse to fine (1..6)");
-  o->Add("Refine.iterations_per_level", &r->iterations_per_level,
-         "gradient + denoising iterations per level (>= 0)");
-  o->Add("Refine.target_edge_px", &r->target_edge_px,
-         "target triangle edge length in pixels at each level (> 0)");
-  o->Add("Refine.max_faces", &r->max_faces, "face budget (0: 2x input faces, at least 100k)");
-  o->Add("Refine.step", &r->step, "fraction of the Gauss-Newton step per iteration (0, 1]");
-  o->Add("Refine.max_step_px", &r->max_step_px,
-         "largest vertex motion per iteration, in pixel footprints (> 0)");
-  o->Add("Refine.damping", &r->damping, "Levenberg damping relative to the median curvature");
-  o->Add("Refine.similarity", &r->similarity, "dcv (detail-preserving) or zncc");
-  o->Add("Refine.kappa", &r->kappa, "final weight of the detail-preserving term (>= 0)");
-  o->Add("Refine.regularizer", &r->regularizer, "lp (content-aware L_p), laplacian or none");
-  o->Add("Refine.silhouette_weight", &r->silhouette_weight,
-         "weight of the silhouette term when masks exist (>= 0)");
-  o->Add("Refine.cache_mb", &r->cache_mb, "memory budget for cached images and renders (MB)");
-  o->Add("ViewSelection.num_neighbors", &r->view_selection.num_neighbors,
-         "neighbour views per view (1..16)");
-  o->Add("ViewSelection.ideal_angle_deg", &r->view_selection.ideal_angle_deg,
-         "preferred triangulation angle (degrees)");
-  o->Add("Similarity.sigma", &r->similarity_options.sigma,
-         "Gaussian window sigma in pixels");
-  o->Add("Similarity.epsilon", &r->similarity_options.epsilon,
-         "variance regulariser (intensity^2, images in [0,1])");
-  RegisterDenoiseOptions(o, &r->denoise, "Denoise");
 }
 
 // Prints the dry-run summary of a workspace and mesh.

@@ -17,6 +17,7 @@
 #include "render/renderer.h"
 #include "util/error.h"
 #include "util/logging.h"
+#include "util/options.h"
 
 namespace mr {
 namespace {
@@ -87,9 +88,11 @@ void RemeshForLevel(const std::vector<PinholeView>& views, const RefineOptions& 
   if (faces_before > 2 * target_faces) {
     // Large reductions by quadric decimation first (Garland-Heckbert), which
     // keeps the shape better than collapsing to length alone.
-    MR_LOG(VERBOSE) << Decimate(V, F, std::max(4, target_faces)).BriefReport();
+    const DecimateSummary decimated = Decimate(V, F, std::max(4, target_faces));
+    MR_LOG(VERBOSE) << decimated.BriefReport();
   }
-  MR_LOG(VERBOSE) << IsotropicRemesh(V, F, edge).BriefReport();
+  const IsotropicRemeshSummary remeshed = IsotropicRemesh(V, F, edge);
+  MR_LOG(VERBOSE) << remeshed.BriefReport();
   MR_LOG(INFO) << "Remeshed " << faces_before << " -> " << F->rows() << " faces (edge "
                << edge / footprint << " px at this level, " << ElapsedSeconds() - t0 << " s)";
 }
@@ -122,6 +125,24 @@ DataTerm ComputeDataTerm(const MeshGeometry& mesh, const std::vector<PinholeView
     }
   }
   return term;
+}
+
+// Mean plain-ZNCC similarity of all pairs at full resolution through (V, F).
+double FullResolutionSimilarity(const ViewSource& source,
+                                const std::vector<std::pair<int, int>>& pairs,
+                                const SimilarityOptions& similarity,
+                                const PairTermOptions& pair_options, const Eigen::MatrixXd& V,
+                                const Eigen::MatrixXi& F, Renderer* renderer, size_t cache_bytes,
+                                ImageCache* images) {
+  const std::vector<PinholeView> views = source.Views();
+  RenderCache renders(renderer, views, cache_bytes);
+  renderer->SetMesh(V, F);
+  MeshGeometry geometry{&V, &F, FaceNormals(V, F)};
+  SimilarityOptions plain = similarity;
+  plain.method = "zncc";
+  plain.kappa = 0;
+  return ComputeDataTerm(geometry, views, pairs, 0, plain, pair_options, &renders, images)
+      .MeanSimilarity();
 }
 
 // Per-vertex colours: the mean colour of each vertex over the views where
@@ -253,6 +274,10 @@ RefineSummary RefineMesh(const ViewSource& source, const RefineOptions& options,
   }
 
   const std::vector<PinholeView> full_views = source.Views();
+  if (!(MedianFootprint(full_views, V, VertexNormals(V, F)) > 0)) {
+    MR_THROW_INPUT << "the mesh is not visible in any view: no vertex faces a camera inside its "
+                      "image (is the mesh in the same coordinate frame as the sparse model?)";
+  }
   const auto neighbors = SelectNeighbors(full_views, V, VertexNormals(V, F), options.view_selection);
   const auto pairs = NeighborPairs(neighbors);
   summary.num_pairs = static_cast<int>(pairs.size());
@@ -273,6 +298,10 @@ RefineSummary RefineMesh(const ViewSource& source, const RefineOptions& options,
   DenoiseOptions denoise = options.denoise;
   denoise.method = options.regularizer == "laplacian" ? "laplacian" : "lp";
 
+  summary.initial_similarity = FullResolutionSimilarity(source, pairs, similarity, options.pair, V,
+                                                        F, renderer, cache_bytes / 2, &images);
+  MR_LOG(INFO) << "Initial mean similarity (ZNCC, full resolution): "
+               << summary.initial_similarity;
   const int total_iterations = options.num_levels * options.iterations_per_level;
   int global_iteration = 0;
   for (int level = options.num_levels - 1; level >= 0; --level) {
@@ -361,20 +390,6 @@ RefineSummary RefineMesh(const ViewSource& source, const RefineOptions& options,
     }
   }
 
-  // Final photometric state at full resolution, and colours.
-  {
-    const std::vector<PinholeView> views = ScaledViews(source, 0);
-    RenderCache renders(renderer, views, cache_bytes / 2);
-    renderer->SetMesh(V, F);
-    MeshGeometry geometry{&V, &F, FaceNormals(V, F)};
-    SimilarityOptions plain = similarity;
-    plain.kappa = 0;
-    summary.final_similarity =
-        ComputeDataTerm(geometry, views, pairs, 0, plain, options.pair, &renders, &images)
-            .MeanSimilarity();
-  }
-  summary.initial_similarity =
-      summary.iterations.empty() ? summary.final_similarity : summary.iterations.front().mean_similarity;
   // Leave no self-intersection behind (the flow can fold thin parts).
   const SelfIntersectionReport intersections = CountSelfIntersections(V, F);
   summary.self_intersections = static_cast<int>(intersections.intersecting_pairs);
@@ -383,6 +398,8 @@ RefineSummary RefineMesh(const ViewSource& source, const RefineOptions& options,
     MR_LOG(INFO) << "Self-intersections: " << repair.BriefReport();
     summary.self_intersections = static_cast<int>(repair.final_pairs);
   }
+  summary.final_similarity = FullResolutionSimilarity(source, pairs, similarity, options.pair, V, F,
+                                                      renderer, cache_bytes / 2, &images);
   mesh->V = V;
   mesh->F = F;
   mesh->N.resize(0, 3);
@@ -393,6 +410,34 @@ RefineSummary RefineMesh(const ViewSource& source, const RefineOptions& options,
   summary.termination = "FINISHED";
   summary.seconds = ElapsedSeconds() - t_start;
   return summary;
+}
+
+void RegisterRefineOptions(OptionManager* o, RefineOptions* r) {
+  o->Add("Refine.num_levels", &r->num_levels, "image pyramid levels, coarse to fine (1..6)");
+  o->Add("Refine.iterations_per_level", &r->iterations_per_level,
+         "gradient + denoising iterations per level (>= 0)");
+  o->Add("Refine.target_edge_px", &r->target_edge_px,
+         "target triangle edge length in pixels at each level (> 0)");
+  o->Add("Refine.max_faces", &r->max_faces, "face budget (0: 2x input faces, at least 100k)");
+  o->Add("Refine.step", &r->step, "fraction of the Gauss-Newton step per iteration (0, 1]");
+  o->Add("Refine.max_step_px", &r->max_step_px,
+         "largest vertex motion per iteration, in pixel footprints (> 0)");
+  o->Add("Refine.damping", &r->damping, "Levenberg damping relative to the median curvature");
+  o->Add("Refine.similarity", &r->similarity, "dcv (detail-preserving) or zncc");
+  o->Add("Refine.kappa", &r->kappa, "final weight of the detail-preserving term (>= 0)");
+  o->Add("Refine.regularizer", &r->regularizer, "lp (content-aware L_p), laplacian or none");
+  o->Add("Refine.silhouette_weight", &r->silhouette_weight,
+         "weight of the silhouette term when masks exist (>= 0)");
+  o->Add("Refine.cache_mb", &r->cache_mb, "memory budget for cached images and renders (MB)");
+  o->Add("ViewSelection.num_neighbors", &r->view_selection.num_neighbors,
+         "neighbour views per view (1..16)");
+  o->Add("ViewSelection.ideal_angle_deg", &r->view_selection.ideal_angle_deg,
+         "preferred triangulation angle (degrees)");
+  o->Add("Similarity.sigma", &r->similarity_options.sigma,
+         "Gaussian window sigma in pixels");
+  o->Add("Similarity.epsilon", &r->similarity_options.epsilon,
+         "variance regulariser (intensity^2, images in [0,1])");
+  RegisterDenoiseOptions(o, &r->denoise, "Denoise");
 }
 
 double PhotoConsistency(const ViewSource& source, const std::vector<int>& eval_views,

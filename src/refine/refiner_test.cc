@@ -2,6 +2,8 @@
 
 #include <random>
 
+#include <Eigen/Geometry>
+
 #include "eval/evaluator.h"
 #include "geometry/mesh.h"
 #include "geometry/primitives.h"

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 
+#include <Eigen/Geometry>
 #include <opencv2/imgproc.hpp>
 
 #include "refine/pyramid.h"

@@ -2,6 +2,7 @@
 
 #include <cmath>
 
+#include <Eigen/Geometry>
 #include <opencv2/imgproc.hpp>
 
 #include "geometry/mesh.h"

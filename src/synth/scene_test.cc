@@ -1,0 +1,251 @@
+#include "synth/scene.h"
+
+#include <algorithm>
+#include <cmath>
+#include <numeric>
+#include <vector>
+
+#include <Eigen/Geometry>
+#include <gtest/gtest.h>
+
+#include "synth/synth_test_util.h"
+#include "util/error.h"
+
+namespace mr {
+namespace {
+
+using testing_util::CoarseScene;
+using testing_util::PointMeshDistance;
+
+std::vector<PinholeView> SmallRing(const SynthScene& scene, int width = 160, int height = 120) {
+  CameraRigOptions rig;
+  rig.num_views = 6;
+  rig.width = width;
+  rig.height = height;
+  return MakeCameras(rig, scene.V.rowwise().norm().maxCoeff());
+}
+
+TEST(CameraRigOptions, DefaultsAreValid) { EXPECT_TRUE(CameraRigOptions().Check()); }
+TEST(DepthNoiseOptions, DefaultsAreValid) { EXPECT_TRUE(DepthNoiseOptions().Check()); }
+
+TEST(CameraRigOptions, RejectsBadValues) {
+  CameraRigOptions rig;
+  rig.layout = "spiral";
+  EXPECT_THROW(rig.Check(), InputError);
+  rig = CameraRigOptions();
+  rig.num_views = 1;
+  EXPECT_THROW(rig.Check(), InputError);
+}
+
+TEST(MakeCameras, RingLooksAtCentreAtElevation) {
+  CameraRigOptions rig;
+  const std::vector<PinholeView> views = MakeCameras(rig, 40.0);
+  ASSERT_EQ(views.size(), 16u);
+  for (const PinholeView& v : views) {
+    EXPECT_NEAR((v.R * v.R.transpose() - Eigen::Matrix3d::Identity()).norm(), 0, 1e-12);
+    EXPECT_NEAR(v.R.determinant(), 1, 1e-12);
+    const Eigen::Vector2d o = v.Project(Eigen::Vector3d::Zero());
+    EXPECT_NEAR(o.x(), 320, 1e-9);
+    EXPECT_NEAR(o.y(), 240, 1e-9);
+    const Eigen::Vector3d c = v.Center();
+    EXPECT_NEAR(std::asin(c.z() / c.norm()) * 180 / M_PI, 30, 1e-9);
+    // World up (+z) points up in the image (negative image y).
+    EXPECT_LT(v.Project(Eigen::Vector3d(0, 0, 10)).y(), 240);
+    // The bounding sphere fills fill_fraction of the height: the tangent ray
+    // makes angle alpha with the axis, tan(alpha) * f = 0.35 * height.
+    const double alpha = std::asin(40.0 / c.norm());
+    EXPECT_NEAR(std::tan(alpha) * v.fy, 0.5 * rig.fill_fraction * 480, 1e-6);
+  }
+}
+
+TEST(MakeCameras, HemisphereSpreadsElevations) {
+  CameraRigOptions rig;
+  rig.layout = "hemisphere";
+  rig.num_views = 20;
+  const std::vector<PinholeView> views = MakeCameras(rig, 40.0);
+  double lo = 90, hi = -90;
+  for (const PinholeView& v : views) {
+    const Eigen::Vector3d c = v.Center();
+    const double el = std::asin(c.z() / c.norm()) * 180 / M_PI;
+    lo = std::min(lo, el);
+    hi = std::max(hi, el);
+  }
+  EXPECT_GE(lo, rig.min_elevation_deg);
+  EXPECT_LE(hi, rig.max_elevation_deg);
+  EXPECT_GT(hi - lo, 40);
+}
+
+TEST(RenderImage, NonBlackExactlyWhereObjectProjects) {
+  const SynthScene scene = CoarseScene();
+  const std::vector<PinholeView> views = SmallRing(scene);
+  Renderer renderer;
+  renderer.SetMesh(scene.V, scene.F);
+  for (const PinholeView& view : views) {
+    const SynthImage image = RenderImage(renderer, scene, view, 3);
+    int covered = 0, vertex_hits = 0, vertex_total = 0;
+    for (size_t i = 0; i < image.radiance.size(); ++i) {
+      if (image.coverage[i] == 0) {
+        ASSERT_EQ(image.radiance[i], 0.f);
+      } else {
+        ASSERT_GT(image.radiance[i], 0.f);
+        ++covered;
+      }
+    }
+    EXPECT_GT(covered, 0.1 * image.radiance.size());
+    for (int v = 0; v < scene.V.rows(); ++v) {
+      const Eigen::Vector2d p = view.Project(scene.V.row(v).transpose());
+      if (!view.InImage(p)) continue;
+      ++vertex_total;
+      const size_t idx = static_cast<size_t>(p.y()) * image.width + static_cast<size_t>(p.x());
+      if (image.coverage[idx] > 0) ++vertex_hits;
+    }
+    EXPECT_GT(vertex_hits, 0.99 * vertex_total);
+  }
+}
+
+// The image at pixel (col, row) must show the texture-predicted radiance of
+// the surface point seen through the pixel centre (col + 0.5, row + 0.5),
+// found by an independent CPU ray cast. A one-pixel shift must be detectably worse.
+TEST(RenderImage, PixelsMatchTexturePrediction) {
+  SynthScene scene = CoarseScene();
+  scene.appearance.texture_scale = 2.5;  // features of several pixels at 320x240
+  const std::vector<PinholeView> views = SmallRing(scene, 320, 240);
+  Renderer renderer;
+  renderer.SetMesh(scene.V, scene.F);
+  const PinholeView& view = views[1];
+  const SynthImage image = RenderImage(renderer, scene, view, 3);
+  const RenderBuffers ref = RenderCpu(scene.V, scene.F, view);
+  double err = 0, err_shift = 0;
+  int n = 0;
+  for (int row = 1; row + 1 < view.height; ++row) {
+    for (int col = 1; col + 2 < view.width; ++col) {
+      const size_t idx = static_cast<size_t>(row) * view.width + col;
+      if (image.coverage[idx] < 1 || image.coverage[idx + 1] < 1) continue;
+      const double predicted = ShadeBufferPixel(scene, ref, idx);
+      ASSERT_GE(predicted, 0);
+      err += std::abs(image.radiance[idx] - predicted);
+      err_shift += std::abs(image.radiance[idx + 1] - predicted);
+      ++n;
+    }
+  }
+  ASSERT_GT(n, 1000);
+  err /= n;
+  err_shift /= n;
+  EXPECT_LT(err, 0.02) << "mean |image - prediction| (radiance in [0, 1])";
+  EXPECT_GT(err_shift, 2 * err);
+}
+
+TEST(RenderDenseMaps, DepthPixelsBackProjectOntoSurfaceWithDenseConvention) {
+  const SynthScene scene = CoarseScene();
+  const std::vector<PinholeView> views = SmallRing(scene);
+  Renderer renderer;
+  renderer.SetMesh(scene.V, scene.F);
+  DepthNoiseOptions exact;
+  exact.depth_noise = 0;
+  exact.correlated_noise = 0;
+  exact.depth_blur_px = 0;
+  exact.outlier_fraction = 0;
+  exact.normal_noise = 0;
+  const PinholeView& view = views[2];
+  const DenseMaps maps = RenderDenseMaps(renderer, scene, view, exact, 1);
+  ASSERT_EQ(maps.depth.width, view.width);
+  ASSERT_EQ(maps.normal.channels, 3);
+  double max_dist = 0, sum_dist_sparse = 0;
+  int n = 0, normals_ok = 0;
+  for (int row = 0; row < view.height; row += 3) {
+    for (int col = 0; col < view.width; col += 3) {
+      const float d = maps.depth.At(row, col, 0);
+      if (d == 0) continue;
+      // COLMAP's dense convention: pixel (col, row) is image point (col, row).
+      const Eigen::Vector3d X = view.Center() + d * view.RayDirection(col, row);
+      max_dist = std::max(max_dist, PointMeshDistance(X, scene.V, scene.F));
+      // The sparse convention would put it half a pixel off.
+      const Eigen::Vector3d Y = view.Center() + d * view.RayDirection(col + 0.5, row + 0.5);
+      sum_dist_sparse += PointMeshDistance(Y, scene.V, scene.F);
+      const Eigen::Vector3d n_cam(maps.normal.At(row, col, 0), maps.normal.At(row, col, 1),
+                                  maps.normal.At(row, col, 2));
+      EXPECT_NEAR(n_cam.norm(), 1, 1e-5);
+      EXPECT_LT(n_cam.dot(view.WorldToCamera(X)), 0) << "normal must face the camera";
+      const int f = maps.exact.FaceAt(row, col);
+      if (std::abs(n_cam.dot(view.R * scene.face_normals.row(f).transpose())) > 0.9999) {
+        ++normals_ok;
+      }
+      ++n;
+    }
+  }
+  ASSERT_GT(n, 200);
+  EXPECT_LT(max_dist, 1e-3);
+  EXPECT_GT(sum_dist_sparse / n, 20 * max_dist);
+  EXPECT_EQ(normals_ok, n);
+}
+
+TEST(RenderDenseMaps, NoiseHasRequestedLevel) {
+  const SynthScene scene = CoarseScene();
+  const std::vector<PinholeView> views = SmallRing(scene);
+  Renderer renderer;
+  renderer.SetMesh(scene.V, scene.F);
+  DepthNoiseOptions noisy;
+  noisy.depth_noise = 0.004;
+  noisy.correlated_noise = 0.003;
+  noisy.depth_blur_px = 0;
+  noisy.outlier_fraction = 0;
+  const DenseMaps maps = RenderDenseMaps(renderer, scene, views[0], noisy, 7);
+  double sum2 = 0;
+  int n = 0;
+  for (int row = 0; row < views[0].height; ++row) {
+    for (int col = 0; col < views[0].width; ++col) {
+      const float d = maps.depth.At(row, col, 0);
+      if (d == 0) continue;
+      const double rel = d / maps.exact.DepthAt(row, col) - 1;
+      sum2 += rel * rel;
+      ++n;
+    }
+  }
+  ASSERT_GT(n, 1000);
+  EXPECT_NEAR(std::sqrt(sum2 / n), 0.005, 0.0005);  // sqrt(0.004^2 + 0.003^2)
+}
+
+TEST(MakeSparseModel, TracksReprojectAndAreVisible) {
+  const SynthScene scene = CoarseScene();
+  const std::vector<PinholeView> views = SmallRing(scene);
+  Renderer renderer;
+  renderer.SetMesh(scene.V, scene.F);
+  std::vector<RenderBuffers> exact;
+  std::vector<SynthImage> images;
+  std::vector<std::string> names;
+  for (size_t i = 0; i < views.size(); ++i) {
+    exact.push_back(renderer.Render(DenseConventionView(views[i])));
+    images.push_back(RenderImage(renderer, scene, views[i], 1));
+    names.push_back("view_" + std::to_string(i) + ".png");
+  }
+  const Reconstruction model = MakeSparseModel(scene, views, names, exact, images, 300, 3);
+  ASSERT_EQ(model.cameras.size(), 1u);
+  ASSERT_EQ(model.images.size(), views.size());
+  EXPECT_EQ(model.points3D.size(), 300u);
+  std::vector<RenderBuffers> ref;  // independent ray casts, sparse convention
+  for (const PinholeView& view : views) ref.push_back(RenderCpu(scene.V, scene.F, view));
+  int observations = 0, visible = 0;
+  for (const auto& [id, point] : model.points3D) {
+    ASSERT_GE(point.track.size(), 2u);
+    EXPECT_LT(PointMeshDistance(point.xyz, scene.V, scene.F), 1e-6);
+    for (const TrackElement& el : point.track) {
+      const Image& image = model.images.at(el.image_id);
+      const PinholeView view = ViewFromColmap(model.cameras.at(image.camera_id), image);
+      ASSERT_LT(el.point2D_idx, image.points2D.size());
+      const Point2D& p2 = image.points2D[el.point2D_idx];
+      EXPECT_EQ(p2.point3D_id, static_cast<int64_t>(id));
+      EXPECT_LT((view.Project(point.xyz) - p2.xy).norm(), 0.5);
+      // Visible: the ray through the observation's pixel meets the surface
+      // at the point's depth.
+      const RenderBuffers& r = ref[el.image_id - 1];
+      const int col = static_cast<int>(p2.xy.x()), row = static_cast<int>(p2.xy.y());
+      const double z = view.WorldToCamera(point.xyz).z();
+      ++observations;
+      if (r.FaceAt(row, col) >= 0 && std::abs(r.DepthAt(row, col) - z) < 0.01 * z) ++visible;
+    }
+  }
+  EXPECT_GT(visible, 0.97 * observations);
+}
+
+}  // namespace
+}  // namespace mr

@@ -1,0 +1,84 @@
+#pragma once
+
+// workspace_synthesizer: a synthetic COLMAP dense workspace with ground truth.
+//
+// Writes, for a ground-truth mesh (loaded, or the built-in shape) normalised
+// to a bounding-box diagonal of `scene_diagonal` units centred at the origin:
+//   output_path/ground_truth.ply          the normalised ground truth
+//   output_path/dense/images/view_NNNN.png   anti-aliased renders
+//   output_path/dense/masks/view_NNNN.png.png  (write_masks) 255 = object
+//   output_path/dense/sparse/{cameras,images,points3D}.bin
+//   output_path/dense/stereo/{depth_maps,normal_maps}/<name>.geometric.bin
+//   output_path/dense/stereo/{fusion,patch-match}.cfg
+//   output_path/dense/fused.ply, meshed-poisson.ply  (run_colmap: real colmap)
+//   output_path/logs/*.log                 colmap's output
+
+#include <string>
+
+#include "render/renderer.h"
+#include "synth/colmap_runner.h"
+#include "synth/scene.h"
+#include "synth/shape.h"
+#include "synth/texture.h"
+
+namespace mr {
+
+struct SynthesizerOptions {
+  // Output folder (created; its dense/ must not exist yet). Required.
+  std::string output_path;
+  // Ground-truth mesh (.ply or .obj); empty: the built-in `shape`.
+  std::string model_path;
+  // Axis of the loaded model that points up ("x", "y" or "z"); it is rotated
+  // onto the world +z axis that the cameras treat as up. Scanned models such
+  // as the Stanford bunny are often "y".
+  std::string model_up_axis = "z";
+  // Built-in shape when model_path is empty: "builtin".
+  std::string shape = "builtin";
+  // Bounding-box diagonal of the normalised ground truth (scene units). (0, 1e6].
+  double scene_diagonal = 100;
+  // Image supersampling factor per axis for anti-aliasing. Range [1, 8].
+  int supersample = 3;
+  // Write COLMAP masks (dense/masks/<image name>.png).
+  bool write_masks = true;
+  // Maximum number of sparse points3D (each seen in >= 2 views). [0, 1e7].
+  int num_sparse_points = 5000;
+  // Seed of all random numbers (noise, sparse samples). >= 0.
+  int seed = 0;
+  // Run colmap stereo_fusion + poisson_mesher at the end.
+  bool run_colmap = true;
+
+  BuiltinShapeOptions builtin;
+  CameraRigOptions cameras;
+  AppearanceOptions appearance;
+  DepthNoiseOptions noise;
+  ColmapRunOptions colmap;
+  RendererOptions renderer;
+
+  bool Check() const;
+};
+
+struct SynthesizerSummary {
+  int num_gt_vertices = 0;
+  int num_gt_faces = 0;
+  int num_views = 0;
+  int num_points3D = 0;
+  double mean_track_length = 0;
+  double mean_coverage = 0;  // mean fraction of image pixels showing the object
+  bool ran_colmap = false;
+  ColmapRunSummary colmap;
+  double render_seconds = 0;
+  double total_seconds = 0;
+  std::string renderer;
+
+  std::string BriefReport() const;
+};
+
+SynthesizerSummary SynthesizeWorkspace(const SynthesizerOptions& options);
+
+// Name of view i: "view_0000.png", ...
+std::string SynthViewName(int i);
+
+// Writes an 8-bit grayscale-as-RGB PNG of `image` (radiance * 255).
+void WriteSynthImagePng(const std::string& path, const SynthImage& image);
+
+}  // namespace mr

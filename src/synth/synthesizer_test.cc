@@ -1,0 +1,276 @@
+#include "synth/synthesizer.h"
+
+#include <unistd.h>
+
+#include <algorithm>
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <string>
+#include <vector>
+
+#include <gtest/gtest.h>
+
+#include "colmap_io/dense_array.h"
+#include "colmap_io/ply.h"
+#include "colmap_io/sparse_model.h"
+#include "synth/synth_test_util.h"
+#include "util/error.h"
+#include "util/file.h"
+
+namespace mr {
+namespace {
+
+using testing_util::PointMeshDistance;
+
+std::string FreshDir(const std::string& name) {
+  const std::string dir = JoinPaths(::testing::TempDir(),
+                                    "mr_synth_" + name + "_" + std::to_string(getpid()));
+  std::filesystem::remove_all(dir);
+  return dir;
+}
+
+SynthesizerOptions SmallOptions(const std::string& output_path) {
+  SynthesizerOptions options;
+  options.output_path = output_path;
+  options.builtin.edge_length = 2.0;
+  options.cameras.num_views = 6;
+  options.cameras.width = 160;
+  options.cameras.height = 120;
+  options.supersample = 2;
+  options.num_sparse_points = 500;
+  options.run_colmap = false;
+  return options;
+}
+
+TEST(SynthesizerOptions, DefaultsAreValid) {
+  SynthesizerOptions options;
+  options.output_path = "/tmp/x";  // the one required field
+  EXPECT_TRUE(options.Check());
+  EXPECT_TRUE(ColmapRunOptions().Check());
+}
+
+TEST(SynthesizerOptions, RejectsBadValues) {
+  SynthesizerOptions options;
+  EXPECT_THROW(options.Check(), InputError);  // no output_path
+  options.output_path = "/tmp/x";
+  options.supersample = 0;
+  EXPECT_THROW(options.Check(), InputError);
+  options.supersample = 3;
+  options.shape = "teapot";
+  EXPECT_THROW(options.Check(), InputError);
+  options.shape = "builtin";
+  options.colmap.poisson_trim = -1;
+  EXPECT_THROW(options.Check(), InputError);
+}
+
+TEST(Synthesizer, WritesWorkspaceAndGroundTruthBesideIt) {
+  const std::string dir = FreshDir("layout");
+  SynthesizerOptions options = SmallOptions(dir);
+  options.noise.depth_blur_px = 0;  // so that the only error is the noise
+  const SynthesizerSummary summary = SynthesizeWorkspace(options);
+  EXPECT_EQ(summary.num_views, 6);
+  EXPECT_GT(summary.num_points3D, 100);
+  EXPECT_GE(summary.mean_track_length, 2.0);
+  EXPECT_FALSE(summary.ran_colmap);
+  const std::string dense = JoinPaths(dir, "dense");
+  EXPECT_TRUE(ExistsFile(JoinPaths(dir, "ground_truth.ply")));
+  EXPECT_FALSE(ExistsFile(JoinPaths(dense, "ground_truth.ply")));
+  for (const char* f : {"sparse/cameras.bin", "sparse/images.bin", "sparse/points3D.bin",
+                        "stereo/fusion.cfg", "stereo/patch-match.cfg"}) {
+    EXPECT_TRUE(ExistsFile(JoinPaths(dense, f))) << f;
+  }
+  std::vector<std::string> names;
+  for (int i = 0; i < 6; ++i) names.push_back(SynthViewName(i));
+  EXPECT_EQ(names[0], "view_0000.png");
+  EXPECT_EQ(ListFiles(JoinPaths(dense, "images")), names);
+  std::string fusion_cfg, patch_cfg;
+  for (const auto& n : names) {
+    fusion_cfg += n + "\n";
+    patch_cfg += n + "\n__auto__, 20\n";
+    EXPECT_TRUE(ExistsFile(JoinPaths(dense, "masks/" + n + ".png")));
+  }
+  EXPECT_EQ(ReadFileToString(JoinPaths(dense, "stereo/fusion.cfg")), fusion_cfg);
+  EXPECT_EQ(ReadFileToString(JoinPaths(dense, "stereo/patch-match.cfg")), patch_cfg);
+
+  // The sparse model reads back (COLMAP's binary layout) and its tracks
+  // reproject onto their points2D.
+  const Reconstruction model = ReadSparseModelBinary(JoinPaths(dense, "sparse"));
+  ASSERT_EQ(model.cameras.size(), 1u);
+  ASSERT_EQ(model.images.size(), 6u);
+  EXPECT_EQ(static_cast<int>(model.points3D.size()), summary.num_points3D);
+  EXPECT_EQ(model.cameras.begin()->second.model, CameraModel::kPinhole);
+  for (const auto& [id, point] : model.points3D) {
+    ASSERT_GE(point.track.size(), 2u);
+    for (const TrackElement& el : point.track) {
+      const Image& image = model.images.at(el.image_id);
+      const PinholeView view = ViewFromColmap(model.cameras.at(image.camera_id), image);
+      ASSERT_LT(el.point2D_idx, image.points2D.size());
+      EXPECT_EQ(image.points2D[el.point2D_idx].point3D_id, static_cast<int64_t>(id));
+      EXPECT_LT((view.Project(point.xyz) - image.points2D[el.point2D_idx].xy).norm(), 0.5);
+    }
+  }
+  EXPECT_EQ(model.images.at(1).name, "view_0000.png");
+
+  // Ground truth normalised: diagonal 100, centred.
+  const TriangleMesh gt = ReadPly(JoinPaths(dir, "ground_truth.ply"));
+  EXPECT_EQ(gt.NumFaces(), summary.num_gt_faces);
+  const Eigen::RowVector3d lo = gt.V.colwise().minCoeff(), hi = gt.V.colwise().maxCoeff();
+  EXPECT_NEAR((hi - lo).norm(), 100, 1e-3);
+  EXPECT_NEAR((hi + lo).norm(), 0, 1e-3);
+
+  // The written depth maps back-project onto the ground truth, with COLMAP's
+  // dense convention (pixel (col, row) = image point (col, row)), within the
+  // noise (relative sigma ~0.0036 at depth ~130, i.e. ~0.47 units).
+  const std::vector<PinholeView> views =
+      MakeCameras(options.cameras, gt.V.rowwise().norm().maxCoeff());
+  int n = 0, close = 0;
+  for (size_t i = 0; i < views.size(); i += 2) {
+    const DenseArray depth =
+        ReadDenseArray(JoinPaths(dense, "stereo/depth_maps/" + names[i] + ".geometric.bin"));
+    const DenseArray normal =
+        ReadDenseArray(JoinPaths(dense, "stereo/normal_maps/" + names[i] + ".geometric.bin"));
+    ASSERT_EQ(depth.width, 160);
+    ASSERT_EQ(depth.height, 120);
+    ASSERT_EQ(depth.channels, 1);
+    ASSERT_EQ(normal.channels, 3);
+    for (int row = 0; row < depth.height; row += 4) {
+      for (int col = 0; col < depth.width; col += 4) {
+        const float d = depth.At(row, col, 0);
+        if (d == 0) continue;
+        const Eigen::Vector3d X = views[i].Center() + d * views[i].RayDirection(col, row);
+        const double sigma = std::hypot(options.noise.depth_noise, options.noise.correlated_noise) * d;
+        ++n;
+        if (PointMeshDistance(X, gt.V, gt.F) < 3 * sigma) ++close;
+      }
+    }
+  }
+  ASSERT_GT(n, 300);
+  EXPECT_GT(close, 0.97 * n);
+}
+
+TEST(Synthesizer, ExistingWorkspaceIsRejected) {
+  const std::string dir = FreshDir("exists");
+  CreateDirIfNotExists(JoinPaths(dir, "dense"));
+  EXPECT_THROW(SynthesizeWorkspace(SmallOptions(dir)), InputError);
+}
+
+TEST(Synthesizer, MissingModelPath) {
+  SynthesizerOptions options = SmallOptions(FreshDir("missing"));
+  options.model_path = "/nonexistent/model.obj";
+  EXPECT_THROW(SynthesizeWorkspace(options), InputError);
+}
+
+TEST(Synthesizer, LoadsObjModelAndNormalisesIt) {
+  const std::string dir = FreshDir("obj");
+  CreateDirIfNotExists(dir);
+  // An octahedron 4 units across, off-centre.
+  const std::string obj = JoinPaths(dir, "octa.obj");
+  {
+    std::ofstream out(obj);
+    out << "v 12 0 0\nv 8 0 0\nv 10 2 0\nv 10 -2 0\nv 10 0 2\nv 10 0 -2\n"
+        << "f 1 3 5\nf 3 2 5\nf 2 4 5\nf 4 1 5\nf 3 1 6\nf 2 3 6\nf 4 2 6\nf 1 4 6\n";
+  }
+  SynthesizerOptions options = SmallOptions(JoinPaths(dir, "out"));
+  options.model_path = obj;
+  const SynthesizerSummary summary = SynthesizeWorkspace(options);
+  EXPECT_EQ(summary.num_gt_faces, 8);
+  const TriangleMesh gt = ReadPly(JoinPaths(options.output_path, "ground_truth.ply"));
+  EXPECT_NEAR((gt.V.colwise().maxCoeff() - gt.V.colwise().minCoeff()).norm(), 100, 1e-3);
+  EXPECT_GT(summary.mean_coverage, 0.05);
+}
+
+TEST(Synthesizer, ModelUpAxisIsRotatedOntoZ) {
+  const std::string dir = FreshDir("upaxis");
+  CreateDirIfNotExists(dir);
+  // A tetrahedron elongated along y (10 units) and 2 units across otherwise.
+  const std::string obj = JoinPaths(dir, "rod.obj");
+  {
+    std::ofstream out(obj);
+    out << "v 0 0 0\nv 2 0 0\nv 1 0 2\nv 1 10 1\nf 1 3 2\nf 1 2 4\nf 2 3 4\nf 3 1 4\n";
+  }
+  for (const std::string axis : {"y", "z"}) {
+    SynthesizerOptions options = SmallOptions(JoinPaths(dir, "out_" + axis));
+    options.model_path = obj;
+    options.model_up_axis = axis;
+    SynthesizeWorkspace(options);
+    const TriangleMesh gt = ReadPly(JoinPaths(options.output_path, "ground_truth.ply"));
+    const Eigen::RowVector3d extent = gt.V.colwise().maxCoeff() - gt.V.colwise().minCoeff();
+    Eigen::Index longest = 0;
+    extent.maxCoeff(&longest);
+    EXPECT_EQ(longest, axis == "y" ? 2 : 1) << "up axis " << axis;
+  }
+  SynthesizerOptions bad = SmallOptions(JoinPaths(dir, "bad"));
+  bad.model_up_axis = "w";
+  EXPECT_THROW(bad.Check(), InputError);
+}
+
+TEST(ColmapRunner, HelpersAndFailureMessage) {
+  EXPECT_FALSE(FindExecutable("sh").empty());
+  EXPECT_TRUE(FindExecutable("no_such_program_mr_synth").empty());
+  EXPECT_TRUE(FindExecutable("/nonexistent/colmap").empty());
+  const std::string dir = FreshDir("runner");
+  CreateDirIfNotExists(dir);
+  const std::string ply = JoinPaths(dir, "a.ply");
+  {
+    std::ofstream out(ply);
+    out << "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nelement face 0\n"
+        << "property list uchar int vertex_indices\nend_header\n1\n2\n3\n";
+  }
+  long nv = 0, nf = 0;
+  ReadPlyElementCounts(ply, &nv, &nf);
+  EXPECT_EQ(nv, 3);
+  EXPECT_EQ(nf, 0);
+  {
+    std::ofstream out(JoinPaths(dir, "b.ply"));
+    out << "not a ply\n";
+  }
+  EXPECT_THROW(ReadPlyElementCounts(JoinPaths(dir, "b.ply"), &nv, &nf), InputError);
+  ColmapRunOptions options;
+  options.colmap_path = "/bin/false";
+  try {
+    RunColmapFusionAndPoisson(dir, JoinPaths(dir, "logs"), options);
+    FAIL() << "expected a failure";
+  } catch (const std::runtime_error& e) {
+    EXPECT_NE(std::string(e.what()).find("stereo_fusion failed"), std::string::npos) << e.what();
+  }
+  options.colmap_path = "no_such_program_mr_synth";
+  EXPECT_THROW(RunColmapFusionAndPoisson(dir, JoinPaths(dir, "logs"), options), InputError);
+}
+
+// The whole path with the real colmap: stereo_fusion + poisson_mesher give a
+// non-empty mesh close to the ground truth.
+TEST(Synthesizer, EndToEndWithColmap) {
+  const std::string colmap = MR_COLMAP_EXECUTABLE;
+  if (colmap.empty()) GTEST_SKIP() << "colmap not found at configure time";
+  const std::string dir = FreshDir("e2e");
+  SynthesizerOptions options = SmallOptions(dir);
+  options.cameras.num_views = 10;
+  options.cameras.width = 240;
+  options.cameras.height = 180;
+  options.run_colmap = true;
+  options.colmap.colmap_path = colmap;
+  options.colmap.poisson_depth = 8;
+  options.colmap.num_threads = 2;
+  const SynthesizerSummary summary = SynthesizeWorkspace(options);
+  ASSERT_TRUE(summary.ran_colmap);
+  EXPECT_GT(summary.colmap.fused_points, 1000);
+  EXPECT_GT(summary.colmap.poisson_faces, 1000);
+  const std::string dense = JoinPaths(dir, "dense");
+  const TriangleMesh mesh = ReadPly(JoinPaths(dense, "meshed-poisson.ply"));
+  ASSERT_GT(mesh.NumFaces(), 0);
+  const TriangleMesh gt = ReadPly(JoinPaths(dir, "ground_truth.ply"));
+  double sum = 0;
+  int n = 0;
+  const int step = std::max(1, mesh.NumVertices() / 400);
+  for (int v = 0; v < mesh.NumVertices(); v += step, ++n) {
+    sum += PointMeshDistance(mesh.V.row(v).transpose(), gt.V, gt.F);
+  }
+  // Mean distance well under 1% of the 100-unit diagonal.
+  EXPECT_LT(sum / n, 1.0);
+  EXPECT_TRUE(ExistsFile(JoinPaths(dir, "logs/stereo_fusion.log")));
+  EXPECT_TRUE(ExistsFile(JoinPaths(dir, "logs/poisson_mesher.log")));
+}
+
+}  // namespace
+}  // namespace mr

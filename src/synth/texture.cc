@@ -1,0 +1,111 @@
+#include "synth/texture.h"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdint>
+
+#include "util/error.h"
+
+namespace mr {
+namespace {
+
+uint32_t Hash(int x, int y, int z) {
+  uint32_t h = static_cast<uint32_t>(x) * 0x8da6b343u ^ static_cast<uint32_t>(y) * 0xd8163841u ^
+               static_cast<uint32_t>(z) * 0xcb1ab31fu;
+  h ^= h >> 16;
+  h *= 0x7feb352du;
+  h ^= h >> 15;
+  h *= 0x846ca68bu;
+  h ^= h >> 16;
+  return h;
+}
+
+// One of 12 cube-edge gradients, dotted with the offset (Perlin's improved noise).
+double Grad(uint32_t h, double x, double y, double z) {
+  switch (h % 12) {
+    case 0: return x + y;
+    case 1: return -x + y;
+    case 2: return x - y;
+    case 3: return -x - y;
+    case 4: return x + z;
+    case 5: return -x + z;
+    case 6: return x - z;
+    case 7: return -x - z;
+    case 8: return y + z;
+    case 9: return -y + z;
+    case 10: return y - z;
+    default: return -y - z;
+  }
+}
+
+double Fade(double t) { return t * t * t * (t * (t * 6 - 15) + 10); }
+double Lerp(double a, double b, double t) { return a + t * (b - a); }
+
+}  // namespace
+
+bool AppearanceOptions::Check() const {
+  if (!(texture_scale > 0 && texture_scale <= 1000)) {
+    MR_THROW_INPUT << "AppearanceOptions::texture_scale = " << texture_scale
+                   << ". Violated constraint: 0 < texture_scale <= 1000";
+  }
+  if (!(texture_contrast > 0 && texture_contrast <= 100)) {
+    MR_THROW_INPUT << "AppearanceOptions::texture_contrast = " << texture_contrast
+                   << ". Violated constraint: 0 < texture_contrast <= 100";
+  }
+  if (!(min_albedo >= 0 && min_albedo < max_albedo && max_albedo <= 1)) {
+    MR_THROW_INPUT << "AppearanceOptions::min_albedo/max_albedo = " << min_albedo << "/"
+                   << max_albedo << ". Violated constraint: 0 <= min_albedo < max_albedo <= 1";
+  }
+  if (!(ambient >= 0 && ambient <= 1)) {
+    MR_THROW_INPUT << "AppearanceOptions::ambient = " << ambient
+                   << ". Violated constraint: 0 <= ambient <= 1";
+  }
+  if (!(light_direction.norm() > 0) || !light_direction.allFinite()) {
+    MR_THROW_INPUT << "AppearanceOptions::light_direction = (" << light_direction.transpose()
+                   << "). Violated constraint: non-zero and finite";
+  }
+  return true;
+}
+
+double GradientNoise(const Eigen::Vector3d& p) {
+  const double fx = std::floor(p.x()), fy = std::floor(p.y()), fz = std::floor(p.z());
+  const int X = static_cast<int>(fx), Y = static_cast<int>(fy), Z = static_cast<int>(fz);
+  const double x = p.x() - fx, y = p.y() - fy, z = p.z() - fz;
+  const double u = Fade(x), v = Fade(y), w = Fade(z);
+  const double n000 = Grad(Hash(X, Y, Z), x, y, z);
+  const double n100 = Grad(Hash(X + 1, Y, Z), x - 1, y, z);
+  const double n010 = Grad(Hash(X, Y + 1, Z), x, y - 1, z);
+  const double n110 = Grad(Hash(X + 1, Y + 1, Z), x - 1, y - 1, z);
+  const double n001 = Grad(Hash(X, Y, Z + 1), x, y, z - 1);
+  const double n101 = Grad(Hash(X + 1, Y, Z + 1), x - 1, y, z - 1);
+  const double n011 = Grad(Hash(X, Y + 1, Z + 1), x, y - 1, z - 1);
+  const double n111 = Grad(Hash(X + 1, Y + 1, Z + 1), x - 1, y - 1, z - 1);
+  return Lerp(Lerp(Lerp(n000, n100, u), Lerp(n010, n110, u), v),
+              Lerp(Lerp(n001, n101, u), Lerp(n011, n111, u), v), w);
+}
+
+double Albedo(const AppearanceOptions& options, const Eigen::Vector3d& p) {
+  // Four octaves from 8x down to 1x texture_scale, the fine ones weighted
+  // nearly as much as the coarse ones so that there is contrast at the scale
+  // of a few pixels. Octaves are shifted to decorrelate them.
+  double sum = 0, norm = 0, period = 8 * options.texture_scale, weight = 1;
+  for (int octave = 0; octave < 4; ++octave) {
+    const Eigen::Vector3d shift(17.3 * octave, -5.1 * octave, 9.7 * octave);
+    sum += weight * GradientNoise(p / period + shift);
+    norm += weight;
+    period *= 0.5;
+    weight *= 0.8;
+  }
+  const double n = sum / norm;  // ~[-0.5, 0.5] typically
+  const double t = 0.5 + 0.5 * std::tanh(options.texture_contrast * 2 * n);
+  return options.min_albedo + (options.max_albedo - options.min_albedo) * t;
+}
+
+double ShadePoint(const AppearanceOptions& options, const Eigen::Vector3d& p,
+                  const Eigen::Vector3d& n) {
+  const Eigen::Vector3d light = options.light_direction.normalized();
+  const double lambert = std::max(0.0, n.dot(light));
+  return Albedo(options, p) * (options.ambient + (1 - options.ambient) * lambert);
+}
+
+}  // namespace mr

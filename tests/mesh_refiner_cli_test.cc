@@ -1,0 +1,222 @@
+// End-to-end tests of the mesh_refiner program on a small workspace written
+// with the project's own writers (images rendered from a bumpy sphere, a
+// PINHOLE sparse model, a smooth sphere as the "Poisson" mesh).
+
+#include <gtest/gtest.h>
+
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+
+#include <opencv2/imgcodecs.hpp>
+
+#include "colmap_io/ply.h"
+#include "colmap_io/sparse_model.h"
+#include "geometry/mesh.h"
+#include "geometry/primitives.h"
+#include "refine/test_scene.h"
+#include "render/renderer.h"
+#include "util/file.h"
+
+namespace mr {
+namespace {
+
+namespace fs = std::filesystem;
+
+struct CommandResult {
+  int exit_code = 0;
+  std::string output;
+};
+
+CommandResult RunCommand(const std::string& command) {
+  CommandResult result;
+  const std::string log = fs::temp_directory_path() / ("mr_cli_" + std::to_string(::getpid()) + ".log");
+  const int status = std::system((command + " > " + log + " 2>&1").c_str());
+  result.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+  result.output = ReadFileToString(log);
+  fs::remove(log);
+  return result;
+}
+
+const std::string kRefiner = std::string(MR_BIN_DIR) + "/mesh_refiner";
+// Small and quick: the point here is the program's behaviour, not accuracy.
+const std::string kFast =
+    " --Refine.num_levels 1 --Refine.iterations_per_level 2 --Refine.target_edge_px 4";
+
+class MeshRefinerCli : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    dir_ = fs::temp_directory_path() /
+           ("mr_cli_ws_" + std::string(::testing::UnitTest::GetInstance()->current_test_info()->name()));
+    fs::remove_all(dir_);
+    fs::create_directories(dir_ + "/images");
+    fs::create_directories(dir_ + "/sparse");
+    Renderer renderer;
+    Eigen::MatrixXd V;
+    Eigen::MatrixXi F;
+    MakeBumpySphere(4, 0.06, &V, &F);
+    const InMemoryViewSource source = MakeTestScene(V, F, {}, {}, &renderer);
+    Reconstruction model;
+    for (int i = 0; i < source.NumViews(); ++i) {
+      const PinholeView& view = source.View(i);
+      Camera camera;
+      camera.camera_id = i + 1;
+      camera.model = CameraModel::kPinhole;
+      camera.width = view.width;
+      camera.height = view.height;
+      camera.params = {view.fx, view.fy, view.cx, view.cy};
+      model.cameras[camera.camera_id] = camera;
+      Image image;
+      image.image_id = i + 1;
+      image.camera_id = camera.camera_id;
+      image.name = source.Name(i) + ".png";
+      image.qvec = RotationToQuaternion(view.R);
+      image.tvec = view.t;
+      model.images[image.image_id] = image;
+      cv::Mat u8;
+      source.LoadGray(i).convertTo(u8, CV_8U, 255.0);
+      cv::imwrite(dir_ + "/images/" + image.name, u8);
+    }
+    WriteSparseModelBinary(dir_ + "/sparse", model);
+    TriangleMesh initial;
+    MakeIcosphere(3, 1.0, &initial.V, &initial.F);
+    WritePly(dir_ + "/meshed-poisson.ply", initial);
+  }
+  void TearDown() override { fs::remove_all(dir_); }
+
+  // Writes a sentinel output so that tests can check it is left untouched.
+  void WriteSentinelOutput() {
+    std::ofstream(dir_ + "/meshed-refined.ply") << "sentinel";
+  }
+  bool SentinelIntact() { return ReadFileToString(dir_ + "/meshed-refined.ply") == "sentinel"; }
+
+  std::string dir_;
+};
+
+TEST_F(MeshRefinerCli, Nominal) {
+  const CommandResult r = RunCommand(kRefiner + " --workspace_path " + dir_ + kFast);
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  const TriangleMesh out = ReadPly(dir_ + "/meshed-refined.ply");
+  EXPECT_GT(out.NumFaces(), 100);
+  EXPECT_EQ(out.C.rows(), out.NumVertices()) << "vertex colours expected";
+  EXPECT_NE(r.output.find("DCV refinement: FINISHED"), std::string::npos) << r.output;
+  EXPECT_NE(r.output.find("Renderer:"), std::string::npos) << r.output;
+  // No temporary file left behind.
+  for (const auto& name : ListFiles(dir_)) EXPECT_EQ(name.find(".tmp."), std::string::npos) << name;
+}
+
+TEST_F(MeshRefinerCli, DryRunPrintsSummaryAndWritesNothing) {
+  const CommandResult r = RunCommand(kRefiner + " --workspace_path " + dir_ + " --dry_run");
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  EXPECT_NE(r.output.find("Images:      8 registered"), std::string::npos) << r.output;
+  EXPECT_NE(r.output.find("Faces:       1280"), std::string::npos) << r.output;
+  EXPECT_NE(r.output.find("px at full resolution"), std::string::npos) << r.output;
+  EXPECT_FALSE(ExistsFile(dir_ + "/meshed-refined.ply"));
+}
+
+TEST_F(MeshRefinerCli, DryRunWithTextModel) {
+  const Reconstruction model = ReadSparseModel(dir_ + "/sparse");
+  for (const char* f : {"cameras.bin", "images.bin", "points3D.bin"}) fs::remove(dir_ + "/sparse/" + f);
+  WriteSparseModelText(dir_ + "/sparse", model);
+  const CommandResult r = RunCommand(kRefiner + " --workspace_path " + dir_ + " --dry_run");
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  EXPECT_NE(r.output.find("Images:      8 registered"), std::string::npos) << r.output;
+}
+
+TEST_F(MeshRefinerCli, MissingImageFailsCleanly) {
+  WriteSentinelOutput();
+  fs::remove(dir_ + "/images/view_3.png");
+  const CommandResult r = RunCommand(kRefiner + " --workspace_path " + dir_ + kFast);
+  EXPECT_NE(r.exit_code, 0);
+  EXPECT_NE(r.output.find("ERROR"), std::string::npos) << r.output;
+  EXPECT_NE(r.output.find("view_3.png"), std::string::npos) << r.output;
+  EXPECT_TRUE(SentinelIntact());
+}
+
+TEST_F(MeshRefinerCli, EmptyMeshFailsCleanly) {
+  WriteSentinelOutput();
+  TriangleMesh empty;
+  empty.V.resize(0, 3);
+  empty.F.resize(0, 3);
+  WritePly(dir_ + "/meshed-poisson.ply", empty);
+  const CommandResult r = RunCommand(kRefiner + " --workspace_path " + dir_ + kFast);
+  EXPECT_NE(r.exit_code, 0);
+  EXPECT_NE(r.output.find("no faces"), std::string::npos) << r.output;
+  EXPECT_TRUE(SentinelIntact());
+}
+
+TEST_F(MeshRefinerCli, MeshWithNoVisibleFacesFailsCleanly) {
+  WriteSentinelOutput();
+  TriangleMesh far_away;
+  MakeIcosphere(2, 1.0, &far_away.V, &far_away.F);
+  far_away.V.col(2).array() += 1000.0;
+  WritePly(dir_ + "/meshed-poisson.ply", far_away);
+  const CommandResult r = RunCommand(kRefiner + " --workspace_path " + dir_ + kFast);
+  EXPECT_NE(r.exit_code, 0);
+  EXPECT_NE(r.output.find("not visible"), std::string::npos) << r.output;
+  EXPECT_TRUE(SentinelIntact());
+}
+
+TEST_F(MeshRefinerCli, ViewsWithoutOverlapFailCleanly) {
+  WriteSentinelOutput();
+  // Keep two opposite views only.
+  Reconstruction model = ReadSparseModel(dir_ + "/sparse");
+  for (uint32_t id = 1; id <= 8; ++id) {
+    if (id != 1 && id != 5) model.images.erase(id);
+  }
+  WriteSparseModelBinary(dir_ + "/sparse", model);
+  const CommandResult r = RunCommand(kRefiner + " --workspace_path " + dir_ + kFast);
+  EXPECT_NE(r.exit_code, 0);
+  EXPECT_NE(r.output.find("overlap"), std::string::npos) << r.output;
+  EXPECT_TRUE(SentinelIntact());
+}
+
+TEST_F(MeshRefinerCli, NonManifoldInputIsRepairedWithAMessage) {
+  // Two spheres sharing one vertex: a non-manifold vertex.
+  TriangleMesh a;
+  MakeIcosphere(3, 0.5, &a.V, &a.F);
+  const Eigen::RowVector3d top = a.V.row(0);
+  TriangleMesh mesh;
+  mesh.V.resize(2 * a.V.rows() - 1, 3);
+  mesh.V.topRows(a.V.rows()) = a.V.rowwise() - top;
+  mesh.F.resize(2 * a.F.rows(), 3);
+  mesh.F.topRows(a.F.rows()) = a.F;
+  // Second sphere mirrored through the shared vertex, reusing vertex 0.
+  std::vector<int> map(a.V.rows());
+  map[0] = 0;
+  int next = static_cast<int>(a.V.rows());
+  for (int v = 1; v < a.V.rows(); ++v) {
+    map[v] = next;
+    mesh.V.row(next++) = -(a.V.row(v) - top);
+  }
+  for (int f = 0; f < a.F.rows(); ++f) {
+    mesh.F.row(a.F.rows() + f) << map[a.F(f, 0)], map[a.F(f, 1)], map[a.F(f, 2)];
+  }
+  WritePly(dir_ + "/meshed-poisson.ply", mesh);
+  const CommandResult r = RunCommand(kRefiner + " --workspace_path " + dir_ + kFast);
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  EXPECT_NE(r.output.find("non-manifold: 0 edges, 1 vertices"), std::string::npos) << r.output;
+}
+
+TEST_F(MeshRefinerCli, RefusesToOverwriteInput) {
+  const CommandResult r = RunCommand(kRefiner + " --workspace_path " + dir_ + " --output_path " +
+                                     dir_ + "/meshed-poisson.ply" + kFast);
+  EXPECT_NE(r.exit_code, 0);
+  EXPECT_NE(r.output.find("refusing to overwrite"), std::string::npos) << r.output;
+}
+
+TEST_F(MeshRefinerCli, BadOptionNamesTheField) {
+  const CommandResult r =
+      RunCommand(kRefiner + " --workspace_path " + dir_ + " --Refine.similarity ssd");
+  EXPECT_NE(r.exit_code, 0);
+  EXPECT_NE(r.output.find("RefineOptions::similarity = ssd"), std::string::npos) << r.output;
+}
+
+TEST_F(MeshRefinerCli, MissingWorkspace) {
+  const CommandResult r = RunCommand(kRefiner + " --workspace_path " + dir_ + "/nope");
+  EXPECT_NE(r.exit_code, 0);
+  EXPECT_NE(r.output.find("ERROR"), std::string::npos) << r.output;
+}
+
+}  // namespace
+}  // namespace mr
