@@ -23,6 +23,7 @@
 #include <CGAL/AABB_triangle_primitive.h>
 #include <CGAL/Simple_cartesian.h>
 
+#include "colmap_io/mesh_io.h"
 #include "denoise/denoiser.h"
 #include "denoise/synthetic_meshes.h"
 #include "geometry/mesh.h"
@@ -37,32 +38,10 @@ using Iterator = std::vector<Triangle>::const_iterator;
 using Primitive = CGAL::AABB_triangle_primitive<K, Iterator>;
 using Tree = CGAL::AABB_tree<CGAL::AABB_traits<K, Primitive>>;
 
-// Minimal OBJ reader (v and f lines; polygons fan-triangulated).
 void ReadObj(const std::string& path, Eigen::MatrixXd* V, Eigen::MatrixXi* F) {
-  std::ifstream in(path);
-  if (!in) MR_THROW_INPUT << path << ": cannot open";
-  std::vector<Eigen::Vector3d> verts;
-  std::vector<Eigen::Vector3i> faces;
-  std::string line;
-  while (std::getline(in, line)) {
-    std::istringstream s(line);
-    std::string tag;
-    s >> tag;
-    if (tag == "v") {
-      Eigen::Vector3d p;
-      s >> p.x() >> p.y() >> p.z();
-      verts.push_back(p);
-    } else if (tag == "f") {
-      std::vector<int> idx;
-      std::string tok;
-      while (s >> tok) idx.push_back(std::stoi(tok.substr(0, tok.find('/'))) - 1);
-      for (size_t k = 2; k < idx.size(); ++k) faces.emplace_back(idx[0], idx[k - 1], idx[k]);
-    }
-  }
-  V->resize(static_cast<int>(verts.size()), 3);
-  for (size_t i = 0; i < verts.size(); ++i) V->row(i) = verts[i].transpose();
-  F->resize(static_cast<int>(faces.size()), 3);
-  for (size_t i = 0; i < faces.size(); ++i) F->row(i) = faces[i].transpose();
+  const mr::TriangleMesh mesh = mr::ReadMesh(path);
+  *V = mesh.V;
+  *F = mesh.F;
 }
 
 struct Errors {
@@ -103,7 +82,7 @@ class Metric {
 };
 
 // Experiment-only overrides of the lp options from the environment (MAXIT,
-// FIXP, LSCALE, BMAX, B0, FIXL, BF, UPDOP); unset = defaults. Results in docs/ use none.
+// FIXP, LSCALE, BMAX, B0, FIXL, BF, UPDOP, ESTIT, INNER); unset = defaults. Results in docs/ use none.
 void ApplyEnvOverrides(mr::DenoiseOptions* o) {
   auto env = [](const char* name, double fallback) {
     const char* v = std::getenv(name);
@@ -116,6 +95,8 @@ void ApplyEnvOverrides(mr::DenoiseOptions* o) {
   o->beta_initial = env("B0", o->beta_initial);
   o->fixed_lambda = env("FIXL", o->fixed_lambda);
   o->beta_factor = env("BF", o->beta_factor);
+  o->estimate_iterations = static_cast<int>(env("ESTIT", o->estimate_iterations));
+  o->inner_iterations = static_cast<int>(env("INNER", o->inner_iterations));
   o->update_operator = env("UPDOP", o->update_operator ? 1 : 0) != 0;
 }
 

@@ -193,10 +193,17 @@ void DenoiseLp(const Eigen::MatrixXd& V0, const Eigen::MatrixXi& F, const Denois
     // sigma: the closed form (eq. ca8), which is 0 at X = X0 and grows past
     // the noise once X is over-smoothed; bounded by the robust estimate of
     // the noise in X0 (documented in docs/denoising.md).
-    const double sigma2 =
+    double sigma2 =
         k == 0 ? sigma0 * sigma0 : std::min(SigmaSquaredClosedForm(X, X0), sigma0 * sigma0);
     double theta = 0, p = 0;
-    if (o.fixed_p > 0) {
+    const bool frozen = k >= o.estimate_iterations && !result->iterations.empty();
+    if (frozen) {
+      // Parameters frozen after estimate_iterations rounds; only D is re-weighted.
+      const DenoiseIteration& prev = result->iterations.back();
+      p = prev.p;
+      theta = prev.theta * std::pow(h, p);
+      sigma2 = prev.sigma * prev.sigma / (h * h);
+    } else if (o.fixed_p > 0) {
       p = o.fixed_p;
       theta = ThetaClosedForm(row_norms, p);
     } else {
@@ -223,7 +230,7 @@ void DenoiseLp(const Eigen::MatrixXd& V0, const Eigen::MatrixXi& F, const Denois
     std::vector<double> betas;
     if (k == 0 || o.warm_iterations == 0) {
       for (double b = o.beta_initial; b <= o.beta_max * (1 + 1e-12); b *= o.beta_factor) {
-        betas.push_back(b);
+        for (int j = 0; j < o.inner_iterations; ++j) betas.push_back(b);
       }
     } else {
       betas.assign(o.warm_iterations, o.beta_max);
@@ -273,6 +280,7 @@ bool DenoiseOptions::Check() const {
   MR_CHECK_OPTION(method == "lp" || method == "laplacian" || method == "bilateral_normal",
                   method, "method in {lp, laplacian, bilateral_normal}");
   MR_CHECK_OPTION(max_iterations >= 1, max_iterations, "max_iterations >= 1");
+  MR_CHECK_OPTION(estimate_iterations >= 1, estimate_iterations, "estimate_iterations >= 1");
   MR_CHECK_OPTION(tolerance >= 0, tolerance, "tolerance >= 0");
   MR_CHECK_OPTION(p_min > 0 && p_min <= 1, p_min, "0 < p_min <= 1");
   MR_CHECK_OPTION(p_max >= p_min && p_max <= 1, p_max, "p_min <= p_max <= 1");
@@ -283,6 +291,7 @@ bool DenoiseOptions::Check() const {
   MR_CHECK_OPTION(beta_initial > 0, beta_initial, "beta_initial > 0");
   MR_CHECK_OPTION(beta_max >= beta_initial, beta_max, "beta_max >= beta_initial");
   MR_CHECK_OPTION(beta_factor > 1, beta_factor, "beta_factor > 1");
+  MR_CHECK_OPTION(inner_iterations >= 1, inner_iterations, "inner_iterations >= 1");
   MR_CHECK_OPTION(warm_iterations >= 0, warm_iterations, "warm_iterations >= 0");
   MR_CHECK_OPTION(laplacian_iterations >= 0, laplacian_iterations, "laplacian_iterations >= 0");
   MR_CHECK_OPTION(laplacian_weight > 0 && laplacian_weight <= 1, laplacian_weight,
@@ -362,6 +371,10 @@ void RegisterDenoiseOptions(OptionManager* m, DenoiseOptions* o, const std::stri
   m->Add(name("beta_initial"), &o->beta_initial, "lp: first penalty (mean edge = 1 units), > 0");
   m->Add(name("beta_max"), &o->beta_max, "lp: last penalty, >= beta_initial");
   m->Add(name("beta_factor"), &o->beta_factor, "lp: penalty growth per step, > 1");
+  m->Add(name("inner_iterations"), &o->inner_iterations,
+         "lp: psi/X alternations per beta (one factorisation each beta), >= 1");
+  m->Add(name("estimate_iterations"), &o->estimate_iterations,
+         "lp: outer iterations that re-estimate sigma, p, theta, >= 1");
   m->Add(name("warm_iterations"), &o->warm_iterations,
          "lp: 0 = full continuation each outer iteration; > 0 = warm start at beta_max");
   m->Add(name("update_operator"), &o->update_operator,

@@ -35,12 +35,15 @@ struct DenoiseOptions {
   std::string method = "lp";
 
   // ---- lp (content-aware L_p) ----
-  // Outer iterations (parameter estimation + X-solve), >= 1. The default 2:
-  // round 1 fits p, theta on the noisy input with sigma from its robust
-  // noise estimate; round 2 re-fits sigma, p, theta on round 1's result.
-  // Further rounds drift to ever smaller p (the fitted prior sharpens on its
-  // own output) and over-flatten curved parts: see docs/denoising.md.
-  int max_iterations = 2;
+  // Outer iterations (D re-weighting + X-solve), >= 1. Default 3: round 1
+  // fits p, theta on the noisy input with sigma from its robust noise
+  // estimate; round 2 re-fits sigma, p, theta on round 1's result; round 3
+  // keeps them (see estimate_iterations) and re-weights D. See
+  // docs/denoising.md for why the estimation stops after 2 rounds.
+  int max_iterations = 3;
+  // Outer iterations that re-estimate sigma, p and theta; later ones keep
+  // the last estimate and only re-weight D and re-solve, >= 1.
+  int estimate_iterations = 2;
   // Stop the outer loop when the relative change of X (RMS, in mean edge
   // lengths) falls below this, >= 0.
   double tolerance = 1e-3;
@@ -58,9 +61,11 @@ struct DenoiseOptions {
   double fixed_p = 0.0;
   // Penalty continuation for the splitting, in units where the mean edge
   // length is 1: beta goes beta_initial, * beta_factor, ... up to beta_max.
-  double beta_initial = 0.5;   // > 0
+  double beta_initial = 2.0;   // > 0
   double beta_max = 100;       // >= beta_initial
   double beta_factor = 2.0;    // > 1
+  // psi/X alternations per beta value (the factorisation is reused), >= 1.
+  int inner_iterations = 3;
   // 0: every outer iteration runs the full beta continuation from X0 (the
   // default). > 0: outer iterations after the first warm-start from X at
   // beta_max and run this many psi/X alternations (one factorisation);

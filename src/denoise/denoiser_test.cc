@@ -157,6 +157,24 @@ TEST(Denoise, RotationTranslationAndScaleInvariant) {
   }
 }
 
+TEST(Denoise, ParametersFrozenAfterEstimateIterations) {
+  Eigen::MatrixXd clean, noisy;
+  Eigen::MatrixXi F;
+  NoisyCube(&clean, &noisy, &F);
+  DenoiseOptions o;
+  o.max_iterations = 3;
+  o.estimate_iterations = 2;
+  o.tolerance = 0;
+  const DenoiseResult r = Denoise(noisy, F, o);
+  ASSERT_EQ(r.iterations.size(), 3u);
+  EXPECT_EQ(r.iterations[2].p, r.iterations[1].p);
+  EXPECT_NEAR(r.iterations[2].lambda, r.iterations[1].lambda, 1e-12 * r.iterations[1].lambda);
+  // Round 1 sees the noisy input: p = 1 (noise-dominated rows); the σ of
+  // round 1 is the robust estimate of the noise (0.3 mean edges along normals).
+  EXPECT_EQ(r.iterations[0].p, 1.0);
+  EXPECT_NEAR(r.iterations[0].sigma / (0.3 * 2.0 / 24), 1.0, 0.15);
+}
+
 TEST(Denoise, LambdaScaleZeroishMovesLittle) {
   Eigen::MatrixXd clean, noisy;
   Eigen::MatrixXi F;

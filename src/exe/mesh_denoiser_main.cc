@@ -4,14 +4,14 @@
 //                 [--Denoise.method lp|laplacian|bilateral_normal] [--Denoise.* ...]
 //
 // Defaults: the content-aware L_p denoiser of DCV with every parameter
-// estimated from the mesh. Input .ply (or .obj via ReadMesh), output .ply,
-// written atomically. See docs/denoising.md.
+// estimated from the mesh. Input and output .ply or .obj (by extension);
+// the output is written atomically. See docs/denoising.md.
 
 #include <cstdio>
 #include <exception>
 #include <string>
 
-#include "colmap_io/ply.h"
+#include "colmap_io/mesh_io.h"
 #include "denoise/denoiser.h"
 #include "util/error.h"
 #include "util/file.h"
@@ -27,23 +27,22 @@ int Run(int argc, char** argv) {
   DenoiseOptions denoise;
   OptionManager options("mesh_denoiser",
                         "Denoises a triangle mesh (vertices move, connectivity unchanged).");
-  options.AddRequired("input_path", &input_path, "input mesh (.ply)");
-  options.AddRequired("output_path", &output_path, "output mesh (.ply, written atomically)");
+  options.AddRequired("input_path", &input_path, "input mesh (.ply or .obj)");
+  options.AddRequired("output_path", &output_path,
+                      "output mesh (.ply or .obj, written atomically)");
   options.Add("verbose", &verbose, "verbose logging");
   RegisterDenoiseOptions(&options, &denoise, "Denoise");
   if (!options.Parse(argc, argv)) return 0;
   if (verbose) SetLogLevel(LogLevel::kVerbose);
   denoise.Check();
   if (!ExistsFile(input_path)) MR_THROW_INPUT << input_path << ": no such file";
-  if (GetExtension(input_path) != ".ply") {
-    MR_THROW_INPUT << input_path << ": unsupported extension '" << GetExtension(input_path)
-                   << "' (expected .ply)";
+  for (const std::string* path : {&input_path, &output_path}) {
+    const std::string ext = GetExtension(*path);
+    if (ext != ".ply" && ext != ".obj") {
+      MR_THROW_INPUT << *path << ": unsupported extension '" << ext << "' (expected .ply or .obj)";
+    }
   }
-  if (GetExtension(output_path) != ".ply") {
-    MR_THROW_INPUT << output_path << ": unsupported extension '" << GetExtension(output_path)
-                   << "' (expected .ply)";
-  }
-  TriangleMesh mesh = ReadPly(input_path);
+  TriangleMesh mesh = ReadMesh(input_path);
   MR_LOG(INFO) << "Read " << input_path << ": " << mesh.NumVertices() << " vertices, "
                << mesh.NumFaces() << " faces";
   const DenoiseResult result = Denoise(mesh.V, mesh.F, denoise);
@@ -56,7 +55,7 @@ int Run(int argc, char** argv) {
   MR_LOG(INFO) << result.BriefReport();
   mesh.V = result.V;
   mesh.N.resize(0, 3);  // stale after moving vertices
-  WritePly(output_path, mesh);
+  WriteMesh(output_path, mesh);
   MR_LOG(INFO) << "Wrote " << output_path;
   return 0;
 }
