@@ -12,6 +12,7 @@
 #include <CGAL/Simple_cartesian.h>
 
 #include "geometry/mesh.h"
+#include "render/renderer.h"
 #include "util/error.h"
 #include "util/logging.h"
 
@@ -94,6 +95,7 @@ void CheckMesh(const Eigen::MatrixXd& V, const Eigen::MatrixXi& F, const char* n
 struct Distances {
   std::vector<double> distance;   // per sample
   std::vector<double> angle_deg;  // per sample; NaN where a normal is undefined
+  std::vector<int> target_face;   // per sample: the closest target triangle
 };
 
 // Distance from every sample to the target mesh, and the angle between the
@@ -115,6 +117,7 @@ Distances Query(const std::vector<Sample>& samples, const Eigen::MatrixXd& sampl
   const int n = static_cast<int>(samples.size());
   result.distance.resize(n);
   result.angle_deg.resize(n);
+  result.target_face.resize(n);
 #ifdef _OPENMP
 #pragma omp parallel for schedule(dynamic, 1024)
 #endif
@@ -125,6 +128,7 @@ Distances Query(const std::vector<Sample>& samples, const Eigen::MatrixXd& sampl
     const Eigen::Vector3d c(closest.first.x(), closest.first.y(), closest.first.z());
     result.distance[i] = (c - q).norm();
     const int target_face = static_cast<int>(closest.second - triangles.cbegin());
+    result.target_face[i] = target_face;
     const Eigen::Vector3d a = sample_normals.row(samples[i].face);
     const Eigen::Vector3d b = target_normals.row(target_face);
     if (a.squaredNorm() > 0.5 && b.squaredNorm() > 0.5) {
@@ -164,29 +168,65 @@ std::string EvaluationResult::ToJson() const {
   char text[512];
   std::snprintf(text, sizeof(text),
                 "{\"accuracy90\": %.9g, \"completeness\": %.6f, \"chamfer\": %.9g, "
-                "\"normal_deg\": %.6f, \"mean_accuracy\": %.9g, \"faces\": %d}",
+                "\"normal_deg\": %.6f, \"mean_accuracy\": %.9g, \"faces\": %d",
                 accuracy90, completeness, chamfer, normal_deg, mean_accuracy, faces);
-  return text;
+  std::string json = text;
+  if (observed_percent >= 0) {
+    std::snprintf(text, sizeof(text), ", \"observed_percent\": %.3f", observed_percent);
+    json += text;
+  }
+  return json + "}";
 }
 
 EvaluationResult EvaluateMesh(const Eigen::MatrixXd& V, const Eigen::MatrixXi& F,
                               const Eigen::MatrixXd& gt_V, const Eigen::MatrixXi& gt_F,
-                              const EvaluationOptions& options) {
+                              const EvaluationOptions& options,
+                              const std::vector<char>* gt_observed) {
   options.Check();
   Eigen::VectorXd areas, gt_areas;
   CheckMesh(V, F, "Evaluated", &areas);
   CheckMesh(gt_V, gt_F, "Ground-truth", &gt_areas);
+  if (gt_observed != nullptr) {
+    MR_CHECK_EQ(static_cast<long>(gt_observed->size()), static_cast<long>(gt_F.rows()));
+  }
+  const auto observed = [&](int gt_face) {
+    return gt_observed == nullptr || (*gt_observed)[gt_face] != 0;
+  };
 
   const uint64_t seed = static_cast<uint64_t>(options.seed);
   const std::vector<Sample> samples = SampleMesh(V, F, areas, options.num_samples, 2 * seed);
   const std::vector<Sample> gt_samples =
       SampleMesh(gt_V, gt_F, gt_areas, options.num_samples, 2 * seed + 1);
 
-  const Distances to_gt = Query(samples, FaceNormals(V, F), gt_V, gt_F);
-  const Distances to_recon = Query(gt_samples, FaceNormals(gt_V, gt_F), V, F);
+  Distances to_gt = Query(samples, FaceNormals(V, F), gt_V, gt_F);
+  Distances to_recon = Query(gt_samples, FaceNormals(gt_V, gt_F), V, F);
 
   EvaluationResult result;
   result.faces = static_cast<int>(F.rows());
+  if (gt_observed != nullptr) {
+    // Keep reconstruction samples whose closest ground truth is observed, and
+    // ground-truth samples on observed faces.
+    Distances kept;
+    for (size_t i = 0; i < to_gt.distance.size(); ++i) {
+      if (!observed(to_gt.target_face[i])) continue;
+      kept.distance.push_back(to_gt.distance[i]);
+      kept.angle_deg.push_back(to_gt.angle_deg[i]);
+    }
+    std::vector<double> kept_recon;
+    double observed_area = 0;
+    for (int f = 0; f < gt_F.rows(); ++f) observed_area += observed(f) ? gt_areas(f) : 0.0;
+    for (size_t i = 0; i < gt_samples.size(); ++i) {
+      if (observed(gt_samples[i].face)) kept_recon.push_back(to_recon.distance[i]);
+    }
+    result.observed_percent = 100.0 * observed_area / gt_areas.sum();
+    if (kept.distance.empty() || kept_recon.empty()) {
+      MR_THROW_INPUT << "no sample lies on the observed part of the ground truth ("
+                     << result.observed_percent << "% of its area is observed)";
+    }
+    to_gt.distance = std::move(kept.distance);
+    to_gt.angle_deg = std::move(kept.angle_deg);
+    to_recon.distance = std::move(kept_recon);
+  }
   result.mean_accuracy = Mean(to_gt.distance);
   result.chamfer = result.mean_accuracy + Mean(to_recon.distance);
 
@@ -211,6 +251,26 @@ EvaluationResult EvaluateMesh(const Eigen::MatrixXd& V, const Eigen::MatrixXi& F
   MR_LOG(VERBOSE) << "Evaluated " << F.rows() << " faces against " << gt_F.rows()
                   << " ground-truth faces with " << options.num_samples << " samples each";
   return result;
+}
+
+std::vector<char> ObservedFaces(const Eigen::MatrixXd& V, const Eigen::MatrixXi& F,
+                                const std::vector<PinholeView>& views, int min_views) {
+  MR_CHECK_GE(min_views, 1);
+  std::vector<int> count(F.rows(), 0);
+  Renderer renderer;
+  renderer.SetMesh(V, F);
+  std::vector<char> seen(F.rows());
+  for (const PinholeView& view : views) {
+    const RenderBuffers render = renderer.Render(view);
+    std::fill(seen.begin(), seen.end(), 0);
+    for (int32_t f : render.face_id) {
+      if (f >= 0) seen[f] = 1;
+    }
+    for (int f = 0; f < F.rows(); ++f) count[f] += seen[f];
+  }
+  std::vector<char> observed(F.rows());
+  for (int f = 0; f < F.rows(); ++f) observed[f] = count[f] >= min_views ? 1 : 0;
+  return observed;
 }
 
 }  // namespace mr

@@ -5,7 +5,11 @@
 
 #include <string>
 
+#include <vector>
+
 #include <Eigen/Core>
+
+#include "geometry/view.h"
 
 namespace mr {
 
@@ -26,11 +30,24 @@ struct EvaluationResult {
   double normal_deg = 0;     // mean angle between recon and closest-GT face normals (oriented)
   double mean_accuracy = 0;  // mean recon->GT distance
   int faces = 0;             // faces of the evaluated mesh
+  // With an observed-face mask: % of the ground truth's area observed (the
+  // part all other figures are measured on); -1 without a mask.
+  double observed_percent = -1;
   std::string ToJson() const;  // one line
 };
 
+// With `gt_observed` (one flag per ground-truth face), the figures cover only
+// the observed part of the ground truth, as Middlebury's evaluation does:
+// reconstruction samples whose closest ground-truth face is observed, and
+// ground-truth samples on observed faces.
 EvaluationResult EvaluateMesh(const Eigen::MatrixXd& V, const Eigen::MatrixXi& F,
                               const Eigen::MatrixXd& gt_V, const Eigen::MatrixXi& gt_F,
-                              const EvaluationOptions& options = {});
+                              const EvaluationOptions& options = {},
+                              const std::vector<char>* gt_observed = nullptr);
+
+// Faces of (V, F) whose pixels are visible in at least `min_views` of
+// `views` (rendered through EGL, occlusion included).
+std::vector<char> ObservedFaces(const Eigen::MatrixXd& V, const Eigen::MatrixXi& F,
+                                const std::vector<PinholeView>& views, int min_views);
 
 }  // namespace mr

@@ -295,3 +295,50 @@ TEST(MeshEvaluator, CommandLine) {
 
 }  // namespace
 }  // namespace mr
+
+#include "geometry/mesh.h"
+#include "geometry/primitives.h"
+
+namespace mr {
+namespace {
+
+// A ring of cameras above the equator never sees the bottom of a sphere: a
+// bump there must not count with the observed-face mask, and must without.
+TEST(ObservedFaces, UnseenBumpIsExcluded) {
+  Eigen::MatrixXd V;
+  Eigen::MatrixXi F;
+  MakeIcosphere(4, 1.0, &V, &F);
+  std::vector<PinholeView> views;
+  for (int i = 0; i < 8; ++i) {
+    const double a = 2 * M_PI * i / 8;
+    views.push_back(LookAtView(Eigen::Vector3d(4 * std::cos(a), 4 * std::sin(a), 2.5),
+                               Eigen::Vector3d::Zero(), Eigen::Vector3d(0, 0, 1), 80, 60, 80));
+  }
+  const std::vector<char> observed = ObservedFaces(V, F, views, 2);
+  int seen_top = 0, seen_bottom = 0;
+  const Eigen::MatrixXd N = FaceNormals(V, F);
+  for (int f = 0; f < F.rows(); ++f) {
+    if (N(f, 2) > 0.9) seen_top += observed[f];
+    if (N(f, 2) < -0.9) seen_bottom += observed[f];
+  }
+  EXPECT_GT(seen_top, 0);
+  EXPECT_EQ(seen_bottom, 0);
+
+  Eigen::MatrixXd bumped = V;
+  for (int v = 0; v < V.rows(); ++v) {
+    if (V(v, 2) < -0.8) bumped.row(v) *= 1.2;
+  }
+  EvaluationOptions options;
+  options.num_samples = 20000;
+  const EvaluationResult all = EvaluateMesh(bumped, F, V, F, options);
+  const EvaluationResult masked = EvaluateMesh(bumped, F, V, F, options, &observed);
+  EXPECT_GT(all.accuracy90, 0.05);
+  EXPECT_LT(masked.accuracy90, 1e-9);
+  EXPECT_GT(masked.observed_percent, 30);
+  EXPECT_LT(masked.observed_percent, 95);
+  EXPECT_NE(masked.ToJson().find("observed_percent"), std::string::npos);
+  EXPECT_EQ(all.ToJson().find("observed_percent"), std::string::npos);
+}
+
+}  // namespace
+}  // namespace mr

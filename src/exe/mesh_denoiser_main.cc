@@ -17,6 +17,7 @@
 #include "util/file.h"
 #include "util/logging.h"
 #include "util/options.h"
+#include "util/program.h"
 
 namespace mr {
 namespace {
@@ -64,10 +65,7 @@ int Run(int argc, char** argv) {
 }  // namespace mr
 
 int main(int argc, char** argv) {
-  try {
+  return mr::RunProgram([&]() -> int {
     return mr::Run(argc, argv);
-  } catch (const std::exception& e) {
-    std::fprintf(stderr, "ERROR: %s\n", e.what());
-    return 1;
-  }
+  });
 }

@@ -14,9 +14,12 @@
 #include "util/file.h"
 #include "util/logging.h"
 #include "util/options.h"
+#include "colmap_io/workspace.h"
+#include "geometry/view.h"
+#include "util/program.h"
 
 int main(int argc, char** argv) {
-  try {
+  return mr::RunProgram([&]() -> int {
     std::string input_path;
     std::string gt_path;
     mr::EvaluationOptions options;
@@ -31,6 +34,12 @@ int main(int argc, char** argv) {
     manager.Add("num_samples", &options.num_samples,
                 "area-uniform samples drawn on each mesh (>= 1)");
     manager.Add("seed", &options.seed, "sampler seed (>= 0)");
+    std::string workspace_path;
+    int min_views = 2;
+    manager.Add("workspace_path", &workspace_path,
+                "COLMAP workspace: measure only the ground truth seen by >= min_views of its "
+                "cameras (Middlebury-style observed surface)");
+    manager.Add("min_views", &min_views, "with --workspace_path: views that must see a face (>= 1)");
     if (!manager.Parse(argc, argv)) return 0;
     options.Check();
     for (const std::string& path : {input_path, gt_path}) {
@@ -40,13 +49,20 @@ int main(int argc, char** argv) {
     const mr::TriangleMesh gt = mr::ReadMesh(gt_path);
     if (mesh.NumFaces() == 0) MR_THROW_INPUT << input_path << ": mesh has no faces";
     if (gt.NumFaces() == 0) MR_THROW_INPUT << gt_path << ": mesh has no faces";
-    const mr::EvaluationResult result = mr::EvaluateMesh(mesh.V, mesh.F, gt.V, gt.F, options);
+    std::vector<char> observed;
+    if (!workspace_path.empty()) {
+      if (min_views < 1) MR_THROW_INPUT << "--min_views " << min_views << ": expected >= 1";
+      const mr::Workspace workspace = mr::OpenWorkspace(workspace_path);
+      std::vector<mr::PinholeView> views;
+      for (uint32_t id : workspace.image_ids) {
+        const mr::Image& image = workspace.model.images.at(id);
+        views.push_back(mr::ViewFromColmap(workspace.model.cameras.at(image.camera_id), image));
+      }
+      observed = mr::ObservedFaces(gt.V, gt.F, views, min_views);
+    }
+    const mr::EvaluationResult result = mr::EvaluateMesh(mesh.V, mesh.F, gt.V, gt.F, options,
+                                                         observed.empty() ? nullptr : &observed);
     std::cout << result.ToJson() << std::endl;
     return 0;
-  } catch (const mr::InputError& e) {
-    std::cerr << "ERROR: " << e.what() << std::endl;
-  } catch (const std::exception& e) {
-    std::cerr << "ERROR: " << e.what() << std::endl;
-  }
-  return 1;
+  });
 }

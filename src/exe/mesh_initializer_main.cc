@@ -19,9 +19,10 @@
 #include "util/file.h"
 #include "util/logging.h"
 #include "util/options.h"
+#include "util/program.h"
 
 int main(int argc, char** argv) {
-  try {
+  return mr::RunProgram([&]() -> int {
     std::string workspace_path, output_path, bbox_text;
     bool use_holdout = true, use_silhouette_list = true;
     mr::VisualHullOptions options;
@@ -145,8 +146,5 @@ int main(int argc, char** argv) {
     MR_LOG(INFO) << "Wrote " << output_path << " (" << mesh.NumVertices() << " vertices, "
                  << mesh.NumFaces() << " faces)";
     return 0;
-  } catch (const std::exception& e) {
-    std::cerr << "ERROR: " << e.what() << std::endl;
-    return 1;
-  }
+  });
 }

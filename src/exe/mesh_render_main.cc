@@ -17,6 +17,7 @@
 #include "util/error.h"
 #include "util/logging.h"
 #include "util/options.h"
+#include "util/program.h"
 
 namespace {
 
@@ -48,7 +49,7 @@ Eigen::AlignedBox3d Bounds(const Eigen::MatrixXd& V) {
 }  // namespace
 
 int main(int argc, char** argv) {
-  try {
+  return mr::RunProgram([&]() -> int {
     std::string input_path, output_path, workspace_path, image_name, view_text, side_by_side,
         up_text, front_text;
     int width = 0, height = 0;
@@ -172,8 +173,5 @@ int main(int argc, char** argv) {
                  << (second.NumFaces() > 0 ? " + " + std::to_string(second.NumFaces()) : "")
                  << ")";
     return 0;
-  } catch (const std::exception& e) {
-    std::cerr << "ERROR: " << e.what() << std::endl;
-    return 1;
-  }
+  });
 }

@@ -9,9 +9,10 @@
 #include "util/error.h"
 #include "util/logging.h"
 #include "util/options.h"
+#include "util/program.h"
 
 int main(int argc, char** argv) {
-  try {
+  return mr::RunProgram([&]() -> int {
     std::string input_path, output_path;
     mr::MiddleburyConversionOptions options;
     mr::OptionManager manager(
@@ -46,8 +47,5 @@ int main(int argc, char** argv) {
                    << " .. " << summary.bbox.max().transpose();
     }
     return 0;
-  } catch (const std::exception& e) {
-    std::cerr << "ERROR: " << e.what() << std::endl;
-    return 1;
-  }
+  });
 }

@@ -14,11 +14,12 @@
 
 #include <Eigen/Geometry>
 
-#include "render/icosphere.h"
+#include "geometry/primitives.h"
 #include "render/renderer.h"
 #include "util/error.h"
 #include "util/logging.h"
 #include "util/options.h"
+#include "util/program.h"
 
 namespace {
 
@@ -108,12 +109,7 @@ int Run(int argc, char** argv) {
 }  // namespace
 
 int main(int argc, char** argv) {
-  try {
+  return mr::RunProgram([&]() -> int {
     return Run(argc, argv);
-  } catch (const mr::InputError& e) {
-    std::cerr << "ERROR: " << e.what() << std::endl;
-  } catch (const std::exception& e) {
-    std::cerr << "ERROR: " << e.what() << std::endl;
-  }
-  return 1;
+  });
 }

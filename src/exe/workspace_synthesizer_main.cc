@@ -14,9 +14,10 @@
 #include "util/file.h"
 #include "util/logging.h"
 #include "util/options.h"
+#include "util/program.h"
 
 int main(int argc, char** argv) {
-  try {
+  return mr::RunProgram([&]() -> int {
     mr::SynthesizerOptions o;
     bool verbose = false;
     mr::OptionManager options(
@@ -82,11 +83,5 @@ int main(int argc, char** argv) {
               << "\nGround truth: " << mr::JoinPaths(o.output_path, "ground_truth.ply")
               << std::endl;
     return 0;
-  } catch (const mr::InputError& e) {
-    std::cerr << "ERROR: " << e.what() << std::endl;
-    return 1;
-  } catch (const std::exception& e) {
-    std::cerr << "ERROR: " << e.what() << std::endl;
-    return 1;
-  }
+  });
 }

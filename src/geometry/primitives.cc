@@ -47,4 +47,10 @@ void MakeIcosphere(int subdivisions, double radius, Eigen::MatrixXd* V, Eigen::M
   for (size_t i = 0; i < faces.size(); ++i) F->row(static_cast<int>(i)) = faces[i];
 }
 
+void MakeIcosphere(int subdivisions, double radius, const Eigen::Vector3d& center,
+                   Eigen::MatrixXd* V, Eigen::MatrixXi* F) {
+  MakeIcosphere(subdivisions, radius, V, F);
+  V->rowwise() += center.transpose();
+}
+
 }  // namespace mr

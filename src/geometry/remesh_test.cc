@@ -1,3 +1,4 @@
+#include "geometry/primitives.h"
 #include "geometry/remesh.h"
 
 #include <gtest/gtest.h>
@@ -13,23 +14,8 @@
 namespace mr {
 namespace {
 
-// Unit icosphere: icosahedron (20 faces, outward CCW) with `levels` midpoint
-// subdivisions projected to the sphere: 20 * 4^levels faces.
-void Icosphere(int levels, Eigen::MatrixXd* V, Eigen::MatrixXi* F) {
-  const double t = (1.0 + std::sqrt(5.0)) / 2.0;
-  V->resize(12, 3);
-  *V << -1, t, 0, 1, t, 0, -1, -t, 0, 1, -t, 0, 0, -1, t, 0, 1, t, 0, -1, -t, 0, 1, -t, t, 0,
-      -1, t, 0, 1, -t, 0, -1, -t, 0, 1;
-  F->resize(20, 3);
-  *F << 0, 11, 5, 0, 5, 1, 0, 1, 7, 0, 7, 10, 0, 10, 11, 1, 5, 9, 5, 11, 4, 11, 10, 2, 10, 7, 6,
-      7, 1, 8, 3, 9, 4, 3, 4, 2, 3, 2, 6, 3, 6, 8, 3, 8, 9, 4, 9, 5, 2, 4, 11, 6, 2, 10, 8, 6, 7,
-      9, 8, 1;
-  V->rowwise().normalize();
-  for (int l = 0; l < levels; ++l) {
-    SubdivideMidpoint(V, F);
-    V->rowwise().normalize();
-  }
-}
+// Unit icosphere: 20 * 4^levels faces.
+void Icosphere(int levels, Eigen::MatrixXd* V, Eigen::MatrixXi* F) { MakeIcosphere(levels, 1.0, V, F); }
 
 double MaxRadiusError(const Eigen::MatrixXd& V) {
   return (V.rowwise().norm().array() - 1.0).abs().maxCoeff();

@@ -15,10 +15,11 @@
 #include "render/renderer.h"
 #include "util/error.h"
 #include "util/options.h"
+#include "util/program.h"
 
 int main(int argc, char** argv) {
   using namespace mr;
-  try {
+  return mr::RunProgram([&]() -> int {
     std::string start = "smooth";
     int subdivisions = 5, width = 160, height = 120, views = 8;
     double relief = 0.06, noise = 0.01;
@@ -64,8 +65,5 @@ int main(int argc, char** argv) {
     std::printf("%s", summary.FullReport().c_str());
     std::printf("before %s\nafter  %s\n", before.ToJson().c_str(), after.ToJson().c_str());
     return 0;
-  } catch (const std::exception& e) {
-    std::fprintf(stderr, "ERROR: %s\n", e.what());
-    return 1;
-  }
+  });
 }

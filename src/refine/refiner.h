@@ -29,14 +29,19 @@ class Renderer;
 inline DenoiseOptions ProximalDenoiseOptions() {
   DenoiseOptions options;
   options.max_iterations = 1;
+  options.estimate_iterations = 1;
+  options.beta_initial = 0.5;
   options.beta_factor = 4.0;
+  options.inner_iterations = 1;
   options.laplacian_iterations = 1;
   return options;
 }
 
 struct RefineOptions {
-  // Image pyramid levels (1 = full resolution only; 1..6).
-  int num_levels = 3;
+  // Image pyramid levels (1 = full resolution only; 1..6). 1 suits a
+  // Poisson mesh that is already close; use 3 for a coarse start such as a
+  // visual hull (coarse levels decimate the mesh and lose its detail).
+  int num_levels = 1;
   // Gradient + denoising iterations at each level (>= 0).
   int iterations_per_level = 10;
   // Target triangle edge length in pixels at every level (> 0). The mesh is

@@ -11,7 +11,7 @@
 
 #include <Eigen/Geometry>
 
-#include "render/icosphere.h"
+#include "geometry/primitives.h"
 #include "util/error.h"
 
 namespace mr {

@@ -1,0 +1,19 @@
+#pragma once
+
+// The entry point of every command-line program:
+//
+//   int main(int argc, char** argv) {
+//     return mr::RunProgram([&]() -> int { ... return 0; });
+//   }
+//
+// mr::InputError (bad input: files, flags, workspaces) prints one line
+// "ERROR: <what>"; any other exception "ERROR (internal): <what>". Both
+// return exit status 1.
+
+#include <functional>
+
+namespace mr {
+
+int RunProgram(const std::function<int()>& body);
+
+}  // namespace mr
