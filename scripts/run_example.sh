@@ -14,9 +14,12 @@ if [ ! -f "$EXAMPLE/dense/meshed-poisson.ply" ]; then
 fi
 build/bin/mesh_refiner --workspace_path "$EXAMPLE/dense"
 echo
+# Figures over the surface the cameras observe (Middlebury-style).
 echo "Initial mesh (COLMAP poisson_mesher) vs ground truth:"
-build/bin/mesh_evaluator --input_path "$EXAMPLE/dense/meshed-poisson.ply" --gt_path "$EXAMPLE/ground_truth.ply"
+build/bin/mesh_evaluator --input_path "$EXAMPLE/dense/meshed-poisson.ply" \
+  --gt_path "$EXAMPLE/ground_truth.ply" --workspace_path "$EXAMPLE/dense"
 echo "Refined mesh (mesh_refiner) vs ground truth:"
-build/bin/mesh_evaluator --input_path "$EXAMPLE/dense/meshed-refined.ply" --gt_path "$EXAMPLE/ground_truth.ply"
+build/bin/mesh_evaluator --input_path "$EXAMPLE/dense/meshed-refined.ply" \
+  --gt_path "$EXAMPLE/ground_truth.ply" --workspace_path "$EXAMPLE/dense"
 echo
 echo "Refined mesh: $EXAMPLE/dense/meshed-refined.ply"

@@ -16,27 +16,13 @@
 #include "geometry/primitives.h"
 #include "refine/test_scene.h"
 #include "render/renderer.h"
+#include "tests/command.h"
 #include "util/file.h"
 
 namespace mr {
 namespace {
 
 namespace fs = std::filesystem;
-
-struct CommandResult {
-  int exit_code = 0;
-  std::string output;
-};
-
-CommandResult RunCommand(const std::string& command) {
-  CommandResult result;
-  const std::string log = fs::temp_directory_path() / ("mr_cli_" + std::to_string(::getpid()) + ".log");
-  const int status = std::system((command + " > " + log + " 2>&1").c_str());
-  result.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-  result.output = ReadFileToString(log);
-  fs::remove(log);
-  return result;
-}
 
 const std::string kRefiner = std::string(MR_BIN_DIR) + "/mesh_refiner";
 // Small and quick: the point here is the program's behaviour, not accuracy.

@@ -256,17 +256,30 @@ EvaluationResult EvaluateMesh(const Eigen::MatrixXd& V, const Eigen::MatrixXi& F
 std::vector<char> ObservedFaces(const Eigen::MatrixXd& V, const Eigen::MatrixXi& F,
                                 const std::vector<PinholeView>& views, int min_views) {
   MR_CHECK_GE(min_views, 1);
+  // A face is seen by a view if its centroid faces the camera, projects into
+  // the image, and is not hidden: its depth matches the rendered depth at that
+  // pixel within two pixel footprints. Testing the centroid (not pixel
+  // coverage) counts faces smaller than a pixel too.
+  const Eigen::MatrixXd N = FaceNormals(V, F);
   std::vector<int> count(F.rows(), 0);
   Renderer renderer;
   renderer.SetMesh(V, F);
-  std::vector<char> seen(F.rows());
   for (const PinholeView& view : views) {
     const RenderBuffers render = renderer.Render(view);
-    std::fill(seen.begin(), seen.end(), 0);
-    for (int32_t f : render.face_id) {
-      if (f >= 0) seen[f] = 1;
+    const Eigen::Vector3d center = view.Center();
+#pragma omp parallel for schedule(static)
+    for (int f = 0; f < static_cast<int>(F.rows()); ++f) {
+      const Eigen::Vector3d x = (V.row(F(f, 0)) + V.row(F(f, 1)) + V.row(F(f, 2))) / 3.0;
+      if (N.row(f).dot(center - x) <= 0) continue;
+      const Eigen::Vector3d xc = view.WorldToCamera(x);
+      if (xc.z() <= 0) continue;
+      const Eigen::Vector2d p = view.CameraToImage(xc);
+      if (!view.InImage(p)) continue;
+      const int col = static_cast<int>(p.x()), row = static_cast<int>(p.y());
+      if (render.FaceAt(row, col) < 0) continue;
+      if (std::abs(render.DepthAt(row, col) - xc.z()) > 2.0 * xc.z() / view.fx) continue;
+      ++count[f];
     }
-    for (int f = 0; f < F.rows(); ++f) count[f] += seen[f];
   }
   std::vector<char> observed(F.rows());
   for (int f = 0; f < F.rows(); ++f) observed[f] = count[f] >= min_views ? 1 : 0;

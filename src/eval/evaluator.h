@@ -45,8 +45,9 @@ EvaluationResult EvaluateMesh(const Eigen::MatrixXd& V, const Eigen::MatrixXi& F
                               const EvaluationOptions& options = {},
                               const std::vector<char>* gt_observed = nullptr);
 
-// Faces of (V, F) whose pixels are visible in at least `min_views` of
-// `views` (rendered through EGL, occlusion included).
+// Faces of (V, F) visible in at least `min_views` of `views`: the face's
+// centroid faces the camera, lies in the image and is not occluded (depth
+// test against an EGL render). Works for faces smaller than a pixel.
 std::vector<char> ObservedFaces(const Eigen::MatrixXd& V, const Eigen::MatrixXi& F,
                                 const std::vector<PinholeView>& views, int min_views);
 

@@ -1,0 +1,93 @@
+// mesh_refiner on a workspace whose fused.ply and meshed-poisson.ply were
+// written by COLMAP's own stereo_fusion and poisson_mesher (through
+// workspace_synthesizer), with the sparse model as .bin and, converted by
+// `colmap model_converter`, as .txt. Then a short refinement on it that must
+// improve accuracy on the observed surface.
+
+#include <gtest/gtest.h>
+
+#include <filesystem>
+
+#include "colmap_io/ply.h"
+#include "colmap_io/workspace.h"
+#include "eval/evaluator.h"
+#include "tests/command.h"
+#include "util/file.h"
+
+namespace mr {
+namespace {
+
+namespace fs = std::filesystem;
+
+class ColmapWorkspace : public ::testing::Test {
+ protected:
+  static void SetUpTestSuite() {
+    if (std::string(MR_COLMAP_EXECUTABLE).empty()) return;
+    dir_ = (fs::temp_directory_path() / "mr_colmap_ws").string();
+    fs::remove_all(dir_);
+    const CommandResult r = RunCommand(
+        std::string(MR_BIN_DIR) + "/workspace_synthesizer --output_path " + dir_ +
+        " --num_views 10 --width 480 --height 360 --colmap_path " + MR_COLMAP_EXECUTABLE +
+        " --num_threads 2");
+    ASSERT_EQ(r.exit_code, 0) << r.output;
+  }
+  void SetUp() override {
+    if (std::string(MR_COLMAP_EXECUTABLE).empty()) GTEST_SKIP() << "colmap not found";
+  }
+  static std::string dir_;
+};
+std::string ColmapWorkspace::dir_;
+
+TEST_F(ColmapWorkspace, DryRunWithBinaryAndTextModels) {
+  const std::string dense = dir_ + "/dense";
+  ASSERT_TRUE(ExistsFile(dense + "/fused.ply"));
+  ASSERT_TRUE(ExistsFile(dense + "/meshed-poisson.ply"));
+  CommandResult r =
+      RunCommand(std::string(MR_BIN_DIR) + "/mesh_refiner --workspace_path " + dense + " --dry_run");
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  EXPECT_NE(r.output.find("Images:      10 registered"), std::string::npos) << r.output;
+  EXPECT_NE(r.output.find("meshed-poisson.ply"), std::string::npos) << r.output;
+
+  // The same workspace with the model converted to TXT by colmap itself.
+  const std::string txt = dir_ + "/dense_txt";
+  fs::remove_all(txt);
+  fs::create_directories(txt + "/sparse");
+  fs::create_directory_symlink(fs::absolute(dense + "/images"), txt + "/images");
+  fs::copy_file(dense + "/meshed-poisson.ply", txt + "/meshed-poisson.ply");
+  r = RunCommand("QT_QPA_PLATFORM=offscreen " + std::string(MR_COLMAP_EXECUTABLE) +
+                 " model_converter --input_path " + dense + "/sparse --output_path " + txt +
+                 "/sparse --output_type TXT");
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  ASSERT_TRUE(ExistsFile(txt + "/sparse/cameras.txt"));
+  ASSERT_FALSE(ExistsFile(txt + "/sparse/cameras.bin"));
+  r = RunCommand(std::string(MR_BIN_DIR) + "/mesh_refiner --workspace_path " + txt + " --dry_run");
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  EXPECT_NE(r.output.find("Images:      10 registered"), std::string::npos) << r.output;
+}
+
+TEST_F(ColmapWorkspace, RefinementImprovesObservedAccuracy) {
+  const std::string dense = dir_ + "/dense";
+  const CommandResult r = RunCommand(std::string(MR_BIN_DIR) + "/mesh_refiner --workspace_path " +
+                                     dense + " --Refine.iterations_per_level 6");
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  const TriangleMesh gt = ReadPly(dir_ + "/ground_truth.ply");
+  const TriangleMesh before = ReadPly(dense + "/meshed-poisson.ply");
+  const TriangleMesh after = ReadPly(dense + "/meshed-refined.ply");
+  const Workspace workspace = OpenWorkspace(dense);
+  std::vector<PinholeView> views;
+  for (uint32_t id : workspace.image_ids) {
+    const Image& image = workspace.model.images.at(id);
+    views.push_back(ViewFromColmap(workspace.model.cameras.at(image.camera_id), image));
+  }
+  const std::vector<char> observed = ObservedFaces(gt.V, gt.F, views, 2);
+  EvaluationOptions options;
+  options.num_samples = 50000;
+  const EvaluationResult b = EvaluateMesh(before.V, before.F, gt.V, gt.F, options, &observed);
+  const EvaluationResult a = EvaluateMesh(after.V, after.F, gt.V, gt.F, options, &observed);
+  EXPECT_LT(a.accuracy90, 0.8 * b.accuracy90) << b.ToJson() << "\n" << a.ToJson() << "\n" << r.output;
+  EXPECT_LT(a.chamfer, b.chamfer) << b.ToJson() << "\n" << a.ToJson();
+  EXPECT_GE(a.completeness, b.completeness - 1.0) << b.ToJson() << "\n" << a.ToJson();
+}
+
+}  // namespace
+}  // namespace mr
