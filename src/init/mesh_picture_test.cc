@@ -12,17 +12,11 @@
 #include "init/isosurface.h"
 #include "util/error.h"
 #include "util/file.h"
+#include "util/testing.h"
 #include "util/logging.h"
 
 namespace mr {
 namespace {
-
-std::string TempDir(const std::string& name) {
-  const auto dir = std::filesystem::temp_directory_path() / ("mr_init_test_" + name);
-  std::filesystem::remove_all(dir);
-  std::filesystem::create_directories(dir);
-  return dir.string();
-}
 
 void Sphere(Eigen::MatrixXd* V, Eigen::MatrixXi* F) {
   const int n = 21;
@@ -109,7 +103,7 @@ TEST(RenderMeshPicture, ObjectPixelsAreShaded) {
 TEST(MeshRender, ProgramWritesAPng) {
   const std::string exe = JoinPaths(MR_BIN_DIR, "mesh_render");
   ASSERT_TRUE(ExistsFile(exe)) << exe << " is not built";
-  const std::string dir = TempDir("mesh_render");
+  const std::string dir = MakeTestDir("mesh_render");
   TriangleMesh mesh;
   Sphere(&mesh.V, &mesh.F);
   WritePly(JoinPaths(dir, "sphere.ply"), mesh);

@@ -12,16 +12,10 @@
 #include "geometry/view.h"
 #include "util/error.h"
 #include "util/file.h"
+#include "util/testing.h"
 
 namespace mr {
 namespace {
-
-std::string TempDir(const std::string& name) {
-  const auto dir = std::filesystem::temp_directory_path() / ("mr_init_test_" + name);
-  std::filesystem::remove_all(dir);
-  std::filesystem::create_directories(dir);
-  return dir.string();
-}
 
 void WriteText(const std::string& path, const std::string& text) {
   std::ofstream(path) << text;
@@ -42,7 +36,7 @@ const char kLine2[] =
     "-0.0315356332107 0.659314086504\n";
 
 TEST(ReadMiddleburyPar, Nominal) {
-  const std::string path = JoinPaths(TempDir("par"), "x_par.txt");
+  const std::string path = JoinPaths(MakeTestDir("par"), "x_par.txt");
   WriteText(path, std::string("2\n") + kLine1 + "\n" + kLine2);
   const auto cams = ReadMiddleburyPar(path);
   ASSERT_EQ(cams.size(), 2u);
@@ -56,7 +50,7 @@ TEST(ReadMiddleburyPar, Nominal) {
 }
 
 TEST(ReadMiddleburyPar, BadLines) {
-  const std::string dir = TempDir("par_bad");
+  const std::string dir = MakeTestDir("par_bad");
   const std::string path = JoinPaths(dir, "x_par.txt");
   // A missing field.
   std::string short_line = kLine2;
@@ -89,7 +83,7 @@ TEST(ReadMiddleburyPar, BadLines) {
 }
 
 TEST(MiddleburyToColmap, ProjectionMatchesWithHalfPixelOffset) {
-  const std::string path = JoinPaths(TempDir("par_proj"), "x_par.txt");
+  const std::string path = JoinPaths(MakeTestDir("par_proj"), "x_par.txt");
   WriteText(path, std::string("2\n") + kLine1 + kLine2);
   for (const MiddleburyCamera& mb : ReadMiddleburyPar(path)) {
     for (const double scale : {1.0, 1000.0}) {
@@ -137,7 +131,7 @@ TEST(MiddleburyToColmap, RejectsNonPinholeK) {
 }
 
 TEST(ReadMiddleburyBoundingBox, DinoReadme) {
-  const std::string dir = TempDir("readme");
+  const std::string dir = MakeTestDir("readme");
   const std::string path = JoinPaths(dir, "README.txt");
   WriteText(path,
             "dinoSparseRing data set\n\nThe (tight) bounding box for the dino model is\n"
@@ -216,8 +210,8 @@ TEST(ComputeSilhouette, FillsShadowsAndGrowsByThreePixels) {
 }
 
 TEST(ConvertMiddlebury, TinyDataSet) {
-  const std::string in = TempDir("convert_in");
-  const std::string out = TempDir("convert_out");
+  const std::string in = MakeTestDir("convert_in");
+  const std::string out = MakeTestDir("convert_out");
   // Four 64x48 views of a small scene with a box in README units (metres).
   std::string par = "4\n";
   for (int i = 1; i <= 4; ++i) {
@@ -268,8 +262,8 @@ TEST(ConvertMiddlebury, TinyDataSet) {
 }
 
 TEST(ConvertMiddlebury, MissingImageOrParFile) {
-  const std::string in = TempDir("convert_missing");
-  const std::string out = TempDir("convert_missing_out");
+  const std::string in = MakeTestDir("convert_missing");
+  const std::string out = MakeTestDir("convert_missing_out");
   EXPECT_THROW(ConvertMiddlebury(in, out, MiddleburyConversionOptions()), InputError);
   WriteText(JoinPaths(in, "t_par.txt"), "1\nnope.png 50 0 31.5 0 50 23.5 0 0 1 1 0 0 0 1 0 0 0 1 0 0 1\n");
   EXPECT_THROW(ConvertMiddlebury(in, out, MiddleburyConversionOptions()), InputError);

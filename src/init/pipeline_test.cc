@@ -15,16 +15,10 @@
 #include "init/isosurface.h"
 #include "init/middlebury.h"
 #include "util/file.h"
+#include "util/testing.h"
 
 namespace mr {
 namespace {
-
-std::string TempDir(const std::string& name) {
-  const auto dir = std::filesystem::temp_directory_path() / ("mr_init_test_" + name);
-  std::filesystem::remove_all(dir);
-  std::filesystem::create_directories(dir);
-  return dir.string();
-}
 
 constexpr double kRadius = 0.02;  // metres
 
@@ -71,8 +65,8 @@ void WriteSphereDataSet(const std::string& dir) {
 }
 
 TEST(MiddleburyPipeline, SphereHullInMillimetres) {
-  const std::string in = TempDir("pipeline_in");
-  const std::string ws = TempDir("pipeline_ws");
+  const std::string in = MakeTestDir("pipeline_in");
+  const std::string ws = MakeTestDir("pipeline_ws");
   WriteSphereDataSet(in);
   MiddleburyConversionOptions convert;
   convert.holdout_every = 0;  // all 8 views carve

@@ -6,26 +6,20 @@
 
 #include "util/error.h"
 #include "util/file.h"
+#include "util/testing.h"
 #include "util/options.h"
 
 namespace mr {
 namespace {
 
-std::string TempDir(const std::string& name) {
-  const auto dir = std::filesystem::temp_directory_path() / ("mr_util_test_" + name);
-  std::filesystem::remove_all(dir);
-  std::filesystem::create_directories(dir);
-  return dir.string();
-}
-
 TEST(WriteFileAtomically, Nominal) {
-  const std::string path = JoinPaths(TempDir("atomic"), "a.txt");
+  const std::string path = JoinPaths(MakeTestDir("atomic"), "a.txt");
   WriteFileAtomically(path, [](std::ostream& out) { out << "hello"; });
   EXPECT_EQ(ReadFileToString(path), "hello");
 }
 
 TEST(WriteFileAtomically, FailureLeavesExistingFileUntouched) {
-  const std::string dir = TempDir("atomic_fail");
+  const std::string dir = MakeTestDir("atomic_fail");
   const std::string path = JoinPaths(dir, "a.txt");
   WriteFileAtomically(path, [](std::ostream& out) { out << "old"; });
   EXPECT_THROW(WriteFileAtomically(path,
@@ -44,7 +38,7 @@ TEST(WriteFileAtomically, MissingFolder) {
 }
 
 TEST(OptionManager, FlagsConfigAndOverride) {
-  const std::string dir = TempDir("options");
+  const std::string dir = MakeTestDir("options");
   int iterations = 3;
   double step = 0.5;
   bool dry_run = false;
