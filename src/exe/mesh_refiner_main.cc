@@ -8,7 +8,6 @@
 #include <algorithm>
 #include <cstdio>
 #include <filesystem>
-#include <fstream>
 #include <iostream>
 #include <set>
 
@@ -26,19 +25,6 @@
 
 namespace mr {
 namespace {
-
-std::set<std::string> ReadNameList(const std::string& path) {
-  std::set<std::string> names;
-  std::ifstream in(path);
-  if (!in) MR_THROW_INPUT << path << ": cannot open the held-out list";
-  std::string line;
-  while (std::getline(in, line)) {
-    const auto b = line.find_first_not_of(" \t\r");
-    if (b == std::string::npos || line[b] == '#') continue;
-    names.insert(line.substr(b, line.find_last_not_of(" \t\r") - b + 1));
-  }
-  return names;
-}
 
 // Prints the dry-run summary of a workspace and mesh.
 void PrintSummary(const Workspace& workspace, const ViewSource& source, const TriangleMesh& mesh,
@@ -113,7 +99,10 @@ int Run(int argc, char** argv) {
   }
 
   const std::set<std::string> holdout =
-      holdout_path.empty() ? std::set<std::string>{} : ReadNameList(holdout_path);
+      holdout_path.empty() ? std::set<std::string>{} : [&] {
+        const std::vector<std::string> names = ReadNameList(holdout_path);
+        return std::set<std::string>(names.begin(), names.end());
+      }();
   const WorkspaceViewSource source(workspace, holdout);
   TriangleMesh mesh = ReadPly(input_path);
   MR_LOG(INFO) << "Read " << input_path << ": " << mesh.NumVertices() << " vertices, "

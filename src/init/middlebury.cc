@@ -299,16 +299,8 @@ std::string MiddleburyConversionSummary::BriefReport() const {
 }
 
 std::vector<std::string> ReadImageNameList(const std::string& path) {
-  std::vector<std::string> names;
-  if (!ExistsFile(path)) return names;
-  std::istringstream in(ReadFileToString(path));
-  std::string line;
-  while (std::getline(in, line)) {
-    const std::string s = Trim(line);
-    if (s.empty() || s[0] == '#') continue;
-    names.push_back(s);
-  }
-  return names;
+  if (!ExistsFile(path)) return {};
+  return ReadNameList(path);
 }
 
 Eigen::AlignedBox3d ParseBoundingBox(const std::string& text, const std::string& what) {

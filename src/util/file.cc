@@ -68,6 +68,18 @@ std::string ReadFileToString(const std::string& path) {
   return buffer.str();
 }
 
+std::vector<std::string> ReadNameList(const std::string& path) {
+  std::vector<std::string> names;
+  std::istringstream in(ReadFileToString(path));
+  std::string line;
+  while (std::getline(in, line)) {
+    const auto begin = line.find_first_not_of(" \t\r");
+    if (begin == std::string::npos || line[begin] == '#') continue;
+    names.push_back(line.substr(begin, line.find_last_not_of(" \t\r") - begin + 1));
+  }
+  return names;
+}
+
 void WriteFileAtomically(const std::string& path,
                          const std::function<void(std::ostream&)>& write) {
   const fs::path target(path);

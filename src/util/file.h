@@ -23,6 +23,10 @@ std::vector<std::string> ListFiles(const std::string& dir);
 // Reads a whole file; throws InputError naming the path if it cannot.
 std::string ReadFileToString(const std::string& path);
 
+// The non-empty lines of a text file, trimmed, skipping '#' comments (image
+// name lists such as holdout.txt). Throws InputError if it cannot be read.
+std::vector<std::string> ReadNameList(const std::string& path);
+
 // Writes a file atomically: `write` fills a temporary file in the same folder
 // (opened in binary mode as `path + ".tmp.<pid>"`), which is renamed onto
 // `path` only if `write` returns without throwing and the stream is good. On

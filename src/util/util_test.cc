@@ -37,6 +37,13 @@ TEST(WriteFileAtomically, MissingFolder) {
                InputError);
 }
 
+TEST(ReadNameList, SkipsBlankLinesAndComments) {
+  const std::string path = JoinPaths(MakeTestDir("names"), "list.txt");
+  WriteFileAtomically(path, [](std::ostream& out) { out << "# held out\n a.png \n\nb c.png\r\n"; });
+  EXPECT_EQ(ReadNameList(path), (std::vector<std::string>{"a.png", "b c.png"}));
+  EXPECT_THROW(ReadNameList(path + ".missing"), InputError);
+}
+
 TEST(OptionManager, FlagsConfigAndOverride) {
   const std::string dir = MakeTestDir("options");
   int iterations = 3;
