@@ -7,6 +7,7 @@
 
 #include "util/error.h"
 #include "util/file.h"
+#include "util/testing.h"
 
 namespace mr {
 namespace {
@@ -100,52 +101,46 @@ TEST(MeshIo, ObjVertexColors) {
   EXPECT_EQ(int(mesh.C(2, 2)), 255);
 }
 
-void ExpectInputError(const std::string& path, const std::string& fragment) {
-  try {
-    ReadMesh(path);
-    ADD_FAILURE() << "no InputError for " << path;
-  } catch (const InputError& e) {
-    const std::string what = e.what();
-    EXPECT_NE(what.find(path), std::string::npos) << what;
-    EXPECT_NE(what.find(fragment), std::string::npos) << what;
-  }
+// Reading `path` must fail with a message naming the file and `fragment`.
+void ExpectReadError(const std::string& path, const std::string& fragment) {
+  ExpectInputError([&] { ReadMesh(path); }, {path, fragment});
 }
 
 TEST(MeshIoBadInput, ObjIndexOutOfRange) {
   const std::string path = TempPath("bad_index.obj");
   WriteRaw(path, "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 4\n");
-  ExpectInputError(path, ":4: face vertex index 4 out of range (3 vertices");
+  ExpectReadError(path, ":4: face vertex index 4 out of range (3 vertices");
   WriteRaw(path, "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 0 1 2\n");
-  ExpectInputError(path, "face vertex index 0 out of range");
+  ExpectReadError(path, "face vertex index 0 out of range");
   WriteRaw(path, "v 0 0 0\nv 1 0 0\nv 0 1 0\nf -1 -2 -4\n");
-  ExpectInputError(path, "face vertex index -4 out of range");
+  ExpectReadError(path, "face vertex index -4 out of range");
   // A face may only use vertices defined before it.
   WriteRaw(path, "v 0 0 0\nv 1 0 0\nf 1 2 3\nv 0 1 0\n");
-  ExpectInputError(path, ":3: face vertex index 3");
+  ExpectReadError(path, ":3: face vertex index 3");
 }
 
 TEST(MeshIoBadInput, ObjMalformedLines) {
   const std::string path = TempPath("malformed.obj");
   WriteRaw(path, "v 0 0\n");
-  ExpectInputError(path, ":1: vertex with 2 coordinates");
+  ExpectReadError(path, ":1: vertex with 2 coordinates");
   WriteRaw(path, "v 0 0 zero\n");
-  ExpectInputError(path, "invalid number 'zero'");
+  ExpectReadError(path, "invalid number 'zero'");
   WriteRaw(path, "v 0 0 nan\n");
-  ExpectInputError(path, "non-finite vertex coordinate");
+  ExpectReadError(path, "non-finite vertex coordinate");
   WriteRaw(path, "v 0 0 0\nv 1 0 0\nf 1 2\n");
-  ExpectInputError(path, ":3: face with 2 corners");
+  ExpectReadError(path, ":3: face with 2 corners");
   WriteRaw(path, "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 x 3\n");
-  ExpectInputError(path, "invalid face corner 'x'");
+  ExpectReadError(path, "invalid face corner 'x'");
   WriteRaw(path, "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 /2 3\n");
-  ExpectInputError(path, "invalid face corner '/2'");
+  ExpectReadError(path, "invalid face corner '/2'");
 }
 
 TEST(MeshIoBadInput, UnknownExtensionAndMissingFile) {
   const std::string path = TempPath("mesh.stl");
   WriteRaw(path, "solid\n");
-  ExpectInputError(path, "unsupported mesh extension '.stl'");
+  ExpectReadError(path, "unsupported mesh extension '.stl'");
   EXPECT_THROW(WriteMesh(path, Tetrahedron()), InputError);
-  ExpectInputError(TempPath("missing.obj"), "cannot open");
+  ExpectReadError(TempPath("missing.obj"), "cannot open");
 }
 
 // The shared models: counts from their own headers / `grep -c`.

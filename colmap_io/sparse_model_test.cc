@@ -11,6 +11,7 @@
 #include "colmap_io/test_models.h"
 #include "util/error.h"
 #include "util/file.h"
+#include "util/testing.h"
 
 namespace mr {
 namespace {
@@ -60,20 +61,6 @@ void ExpectEqualModels(const Reconstruction& a, const Reconstruction& b, double 
     for (size_t i = 0; i < pa.track.size(); ++i) {
       EXPECT_EQ(pa.track[i].image_id, pb.track[i].image_id);
       EXPECT_EQ(pa.track[i].point2D_idx, pb.track[i].point2D_idx);
-    }
-  }
-}
-
-// Expects `fn` to throw InputError whose message contains every string in `parts`.
-template <typename Fn>
-void ExpectInputError(Fn fn, const std::vector<std::string>& parts) {
-  try {
-    fn();
-    ADD_FAILURE() << "no InputError thrown";
-  } catch (const InputError& e) {
-    const std::string what = e.what();
-    for (const std::string& p : parts) {
-      EXPECT_NE(what.find(p), std::string::npos) << "'" << p << "' not in: " << what;
     }
   }
 }

@@ -12,25 +12,13 @@
 #include "colmap_io/undistortion.h"
 #include "util/error.h"
 #include "util/file.h"
+#include "util/testing.h"
 
 namespace mr {
 namespace {
 
 using test::TempDir;
 namespace fs = std::filesystem;
-
-template <typename Fn>
-void ExpectInputError(Fn fn, const std::vector<std::string>& parts) {
-  try {
-    fn();
-    ADD_FAILURE() << "no InputError thrown";
-  } catch (const InputError& e) {
-    const std::string what = e.what();
-    for (const std::string& p : parts) {
-      EXPECT_NE(what.find(p), std::string::npos) << "'" << p << "' not in: " << what;
-    }
-  }
-}
 
 // A model of 64x48 images "c.png", "a.png", "sub/b.png" (ids 1, 2, 3).
 Reconstruction MakeModel(CameraModel model, const std::vector<double>& params) {

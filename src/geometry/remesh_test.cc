@@ -17,6 +17,19 @@ namespace {
 // Unit icosphere: 20 * 4^levels faces.
 void Icosphere(int levels, Eigen::MatrixXd* V, Eigen::MatrixXi* F) { MakeIcosphere(levels, 1.0, V, F); }
 
+// The upper half of a unit icosphere: an open mesh with a border.
+void OpenHemisphere(int levels, Eigen::MatrixXd* V, Eigen::MatrixXi* F) {
+  Icosphere(levels, V, F);
+  Eigen::MatrixXi H(F->rows(), 3);
+  int n = 0;
+  for (int f = 0; f < F->rows(); ++f) {
+    if ((*V)((*F)(f, 0), 2) + (*V)((*F)(f, 1), 2) + (*V)((*F)(f, 2), 2) > 0) H.row(n++) = F->row(f);
+  }
+  H.conservativeResize(n, 3);
+  *F = H;
+  RemoveUnreferencedVertices(V, F);
+}
+
 double MaxRadiusError(const Eigen::MatrixXd& V) {
   return (V.rowwise().norm().array() - 1.0).abs().maxCoeff();
 }
@@ -172,16 +185,7 @@ TEST(IsotropicRemesh, SphereReachesTargetEdgeLength) {
 TEST(IsotropicRemesh, ProtectedBorderStaysOnInputBorder) {
   Eigen::MatrixXd V;
   Eigen::MatrixXi F;
-  Icosphere(3, &V, &F);
-  // Keep the upper half: an open mesh.
-  Eigen::MatrixXi H(F.rows(), 3);
-  int n = 0;
-  for (int f = 0; f < F.rows(); ++f) {
-    if (V(F(f, 0), 2) + V(F(f, 1), 2) + V(F(f, 2), 2) > 0) H.row(n++) = F.row(f);
-  }
-  H.conservativeResize(n, 3);
-  F = H;
-  RemoveUnreferencedVertices(&V, &F);
+  OpenHemisphere(3, &V, &F);
   const EdgeTopology topo0 = ComputeEdgeTopology(F, V.rows());
   ASSERT_GT(topo0.NumBoundaryEdges(), 0);
   std::vector<std::pair<Eigen::Vector3d, Eigen::Vector3d>> border;
@@ -406,15 +410,8 @@ TEST(Remesh, RandomSoupsNeverCrash) {
 TEST(SubdivideSqrt3, OpenMesh) {
   Eigen::MatrixXd V;
   Eigen::MatrixXi F;
-  Icosphere(2, &V, &F);
-  Eigen::MatrixXi H(F.rows(), 3);
-  int n = 0;
-  for (int f = 0; f < F.rows(); ++f) {
-    if (V(F(f, 0), 2) + V(F(f, 1), 2) + V(F(f, 2), 2) > 0) H.row(n++) = F.row(f);
-  }
-  H.conservativeResize(n, 3);
-  F = H;
-  RemoveUnreferencedVertices(&V, &F);
+  OpenHemisphere(2, &V, &F);
+  const int n = static_cast<int>(F.rows());  // faces before subdividing
   const int nb = ComputeEdgeTopology(F, V.rows()).NumBoundaryEdges();
   ASSERT_GT(nb, 0);
   SubdivideSqrt3(&V, &F);
