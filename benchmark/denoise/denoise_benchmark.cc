@@ -82,7 +82,7 @@ class Metric {
 };
 
 // Experiment-only overrides of the lp options from the environment (MAXIT,
-// FIXP, LSCALE, BMAX, B0, FIXL, BF, UPDOP, ESTIT, INNER); unset = defaults. Results in docs/ use none.
+// FIXP, LSCALE, BMAX, B0, FIXL, BF, UPDOP, ESTIT, INNER, CGTOL, SOLVER); unset = defaults. Results in docs/ use none.
 void ApplyEnvOverrides(mr::DenoiseOptions* o) {
   auto env = [](const char* name, double fallback) {
     const char* v = std::getenv(name);
@@ -98,6 +98,8 @@ void ApplyEnvOverrides(mr::DenoiseOptions* o) {
   o->estimate_iterations = static_cast<int>(env("ESTIT", o->estimate_iterations));
   o->inner_iterations = static_cast<int>(env("INNER", o->inner_iterations));
   o->update_operator = env("UPDOP", o->update_operator ? 1 : 0) != 0;
+  o->cg_tolerance = env("CGTOL", o->cg_tolerance);
+  if (const char* v = std::getenv("SOLVER")) o->linear_solver = v;
 }
 
 double PeakMemoryMiB() {
@@ -184,7 +186,7 @@ int Quality(const std::string& models_dir, const std::string& only, const std::s
   return 0;
 }
 
-int Speed(long faces) {
+int Speed(long faces, const std::string& linear_solver) {
   const int n = static_cast<int>(std::lround(std::sqrt(faces / 12.0)));
   Eigen::MatrixXd V;
   Eigen::MatrixXi F;
@@ -192,12 +194,18 @@ int Speed(long faces) {
   const Eigen::MatrixXd noisy = mr::AddNormalNoise(V, F, 0.3 * 2.0 / n, 1);
   const double before = PeakMemoryMiB();
   mr::DenoiseOptions options;
+  options.linear_solver = linear_solver;
   const mr::DenoiseResult r = mr::Denoise(noisy, F, options);
-  int factorizations = 0;
-  for (const auto& it : r.iterations) factorizations += it.num_factorizations;
-  std::printf("| %ld | %ld | %.2f | %.2f | %.2f | %zu | %d | %.0f | %.0f |\n", F.rows(), V.rows(),
-              r.total_seconds, r.setup_seconds, r.solve_seconds, r.iterations.size(),
-              factorizations, before, PeakMemoryMiB());
+  int factorizations = 0, cg_iterations = 0;
+  for (const auto& it : r.iterations) {
+    factorizations += it.num_factorizations;
+    cg_iterations += it.num_cg_iterations;
+  }
+  // faces | vertices | solver | total s | setup s | solve s | outer iterations |
+  // factorisations | cg iterations | peak MiB before | peak MiB after
+  std::printf("| %ld | %ld | %s | %.2f | %.2f | %.2f | %zu | %d | %d | %.0f | %.0f |\n", F.rows(),
+              V.rows(), linear_solver.c_str(), r.total_seconds, r.setup_seconds, r.solve_seconds,
+              r.iterations.size(), factorizations, cg_iterations, before, PeakMemoryMiB());
   return 0;
 }
 
@@ -211,8 +219,8 @@ int main(int argc, char** argv) {
     if (mode == "one" && argc > 2) {
       return Quality(MR_SHARED_DIR "/data/models", argv[2], argc > 3 ? argv[3] : "lp");
     }
-    if (mode == "speed" && argc > 2) return Speed(std::stol(argv[2]));
-    std::fprintf(stderr, "usage: denoise_benchmark quality [MODELS_DIR] | speed NUM_FACES\n");
+    if (mode == "speed" && argc > 2) return Speed(std::stol(argv[2]), argc > 3 ? argv[3] : "cg");
+    std::fprintf(stderr, "usage: denoise_benchmark quality [MODELS_DIR] | speed NUM_FACES [cg|cholesky]\n");
     return 1;
   } catch (const std::exception& e) {
     std::fprintf(stderr, "ERROR: %s\n", e.what());

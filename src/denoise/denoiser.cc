@@ -32,6 +32,8 @@ double Now() {
                    << ". Violated constraint: " bound;                                 \
   }
 
+using Rows3 = Eigen::Matrix<double, Eigen::Dynamic, 3, Eigen::RowMajor>;
+
 // The lower triangle of I + 2 beta D^T D with a fixed sparsity pattern; the
 // values are refilled when D's weights change or beta changes.
 class NormalMatrix {
@@ -64,6 +66,32 @@ class NormalMatrix {
     diag_.resize(n);
     for (int v = 0; v < n; ++v) diag_[v] = Find(v, v);
     dtd_.assign(A_.nonZeros(), 0.0);
+    // Both triangles, row by row, pointing into the lower triangle's values
+    // (for the row-parallel product of the conjugate-gradient solver).
+    const int* outer = A_.outerIndexPtr();
+    const int* inner = A_.innerIndexPtr();
+    full_outer_.assign(n + 1, 0);
+    for (int c = 0; c < n; ++c) {
+      for (int s = outer[c]; s < outer[c + 1]; ++s) {
+        ++full_outer_[inner[s] + 1];
+        if (inner[s] != c) ++full_outer_[c + 1];
+      }
+    }
+    for (int r = 0; r < n; ++r) full_outer_[r + 1] += full_outer_[r];
+    full_col_.resize(full_outer_[n]);
+    full_slot_.resize(full_outer_[n]);
+    std::vector<int> next(full_outer_.begin(), full_outer_.end() - 1);
+    for (int c = 0; c < n; ++c) {
+      for (int s = outer[c]; s < outer[c + 1]; ++s) {
+        const int r = inner[s];
+        full_col_[next[r]] = c;
+        full_slot_[next[r]++] = s;
+        if (r != c) {
+          full_col_[next[c]] = r;
+          full_slot_[next[c]++] = s;
+        }
+      }
+    }
   }
 
   // Recomputes D^T D from the weights.
@@ -77,6 +105,28 @@ class NormalMatrix {
         }
       }
     }
+  }
+
+  // Y = A P with A the symmetric matrix whose lower triangle Matrix() last
+  // filled; P, Y #V by 3, row-major (one row per vertex). Rows in parallel.
+  void Multiply(const Rows3& P, Rows3* Y) const {
+    Y->resize(P.rows(), 3);
+    const double* values = A_.valuePtr();
+#pragma omp parallel for schedule(static) if (P.rows() > 20000)
+    for (int r = 0; r < static_cast<int>(P.rows()); ++r) {
+      Eigen::RowVector3d y = Eigen::RowVector3d::Zero();
+      for (int s = full_outer_[r]; s < full_outer_[r + 1]; ++s) {
+        y += values[full_slot_[s]] * P.row(full_col_[s]);
+      }
+      Y->row(r) = y;
+    }
+  }
+
+  // Diagonal of A (for the Jacobi preconditioner).
+  Eigen::VectorXd Diagonal() const {
+    Eigen::VectorXd d(diag_.size());
+    for (size_t v = 0; v < diag_.size(); ++v) d[v] = A_.valuePtr()[diag_[v]];
+    return d;
   }
 
   // A = I + 2 beta D^T D (lower triangle).
@@ -101,6 +151,7 @@ class NormalMatrix {
   std::vector<int> slots_;
   std::vector<int> diag_;
   std::vector<double> dtd_;
+  std::vector<int> full_outer_, full_col_, full_slot_;
 };
 
 #ifdef MR_HAVE_CHOLMOD
@@ -108,6 +159,45 @@ using Cholesky = Eigen::CholmodSupernodalLLT<Eigen::SparseMatrix<double>, Eigen:
 #else
 using Cholesky = Eigen::SimplicialLDLT<Eigen::SparseMatrix<double>, Eigen::Lower>;
 #endif
+
+// Solves A X = B (A from normal.Matrix(beta)) by Jacobi-preconditioned
+// conjugate gradients on the three columns at once, warm-started from *X (the
+// previous psi/X step's solution, which is close). Stops when the RMS residual
+// per vertex and coordinate is below `tolerance` (in the normalised units,
+// mean edge = 1; A >= I, so the error is at most the residual), or after
+// max_iterations. Returns the iterations used.
+int SolveCg(const NormalMatrix& normal, const Eigen::MatrixXd& B_in, double tolerance,
+            int max_iterations, Eigen::MatrixXd* X_inout) {
+  // CG on the 3n system (A kron I3) x = b: one step length for all three
+  // columns, so the iterates commute with a rotation of the coordinates.
+  const Rows3 B = B_in;
+  Rows3 X = *X_inout;
+  const Eigen::VectorXd inv_diag = normal.Diagonal().cwiseInverse();
+  Rows3 AX;
+  normal.Multiply(X, &AX);
+  Rows3 R = B - AX;
+  Rows3 Z = R.array().colwise() * inv_diag.array();
+  Rows3 P = Z;
+  double rz = (R.array() * Z.array()).sum();
+  const double target = tolerance * tolerance * static_cast<double>(B.size());
+  Rows3 AP;
+  int k = 0;
+  for (; k < max_iterations; ++k) {
+    if (R.squaredNorm() <= target) break;
+    normal.Multiply(P, &AP);
+    const double pap = (P.array() * AP.array()).sum();
+    if (!(pap > 0)) break;
+    const double alpha = rz / pap;
+    X += alpha * P;
+    R -= alpha * AP;
+    Z = R.array().colwise() * inv_diag.array();
+    const double rz_new = (R.array() * Z.array()).sum();
+    P = Z + (rz_new / rz) * P;
+    rz = rz_new;
+  }
+  *X_inout = X;
+  return k;
+}
 
 // D^T Psi without forming D.
 Eigen::MatrixXd ApplyTranspose(const Eigen::MatrixXi& quads, const Eigen::MatrixXd& W,
@@ -174,7 +264,8 @@ void DenoiseLp(const Eigen::MatrixXd& V0, const Eigen::MatrixXi& F, const Denois
   }
   NormalMatrix normal(eq.quads, n);
   Cholesky solver;
-  solver.analyzePattern(normal.Matrix(1.0));
+  const bool direct = o.linear_solver == "cholesky";
+  if (direct) solver.analyzePattern(normal.Matrix(1.0));
   result->setup_seconds = Now() - t0;
 
   const double sigma0 = RobustSigma(ApplyEdgeOperator(eq.quads, W, X0), W);
@@ -247,6 +338,16 @@ void DenoiseLp(const Eigen::MatrixXd& V0, const Eigen::MatrixXi& F, const Denois
       }
       // X-step: (I + 2 beta D^T D) X = X0 + 2 beta D^T psi.
       const Eigen::MatrixXd rhs = X0 + 2.0 * beta * ApplyTranspose(eq.quads, W, Psi, n);
+      if (!direct) {
+        if (beta != factored_beta) {
+          normal.Matrix(beta);
+          factored_beta = beta;
+        }
+        const int used = SolveCg(normal, rhs, o.cg_tolerance, o.cg_max_iterations, &Xk);
+        it.num_cg_iterations += used;
+        if (used >= o.cg_max_iterations) ++it.num_cg_unconverged;
+        continue;
+      }
       if (beta != factored_beta) {
         solver.factorize(normal.Matrix(beta));
         MR_CHECK(solver.info() == Eigen::Success) << "sparse Cholesky failed";
@@ -262,12 +363,18 @@ void DenoiseLp(const Eigen::MatrixXd& V0, const Eigen::MatrixXi& F, const Denois
     std::ostringstream line;
     line << "Denoise lp: iteration " << k + 1 << ": p = " << it.p << ", theta = " << it.theta
          << ", sigma = " << it.sigma << ", lambda = " << it.lambda << ", change = " << it.change
-         << " edge lengths, " << it.num_factorizations << " factorizations, " << it.seconds
+         << " edge lengths, " << (direct ? it.num_factorizations : it.num_cg_iterations)
+         << (direct ? " factorizations, " : " cg iterations, ") << it.seconds
          << " s";
     if (o.verbose) {
       MR_LOG(INFO) << line.str();
     } else {
       MR_LOG(VERBOSE) << line.str();
+    }
+    if (it.num_cg_unconverged > 0) {
+      MR_LOG(WARNING) << "Denoise lp: conjugate gradients hit cg_max_iterations ("
+                      << o.cg_max_iterations << ") in " << it.num_cg_unconverged
+                      << " X-steps; the result is approximate";
     }
     if (it.change < o.tolerance) break;
   }
@@ -292,6 +399,10 @@ bool DenoiseOptions::Check() const {
   MR_CHECK_OPTION(beta_max >= beta_initial, beta_max, "beta_max >= beta_initial");
   MR_CHECK_OPTION(beta_factor > 1, beta_factor, "beta_factor > 1");
   MR_CHECK_OPTION(inner_iterations >= 1, inner_iterations, "inner_iterations >= 1");
+  MR_CHECK_OPTION(linear_solver == "cg" || linear_solver == "cholesky", linear_solver,
+                  "linear_solver in {cg, cholesky}");
+  MR_CHECK_OPTION(cg_tolerance > 0, cg_tolerance, "cg_tolerance > 0");
+  MR_CHECK_OPTION(cg_max_iterations >= 1, cg_max_iterations, "cg_max_iterations >= 1");
   MR_CHECK_OPTION(warm_iterations >= 0, warm_iterations, "warm_iterations >= 0");
   MR_CHECK_OPTION(laplacian_iterations >= 0, laplacian_iterations, "laplacian_iterations >= 0");
   MR_CHECK_OPTION(laplacian_weight > 0 && laplacian_weight <= 1, laplacian_weight,
@@ -373,6 +484,12 @@ void RegisterDenoiseOptions(OptionManager* m, DenoiseOptions* o, const std::stri
   m->Add(name("beta_factor"), &o->beta_factor, "lp: penalty growth per step, > 1");
   m->Add(name("inner_iterations"), &o->inner_iterations,
          "lp: psi/X alternations per beta (one factorisation each beta), >= 1");
+  m->Add(name("linear_solver"), &o->linear_solver,
+         "lp: X-step solver: cg (warm-started conjugate gradients) | cholesky (CHOLMOD)");
+  m->Add(name("cg_tolerance"), &o->cg_tolerance,
+         "lp: cg stops at this RMS residual (mean edge lengths), > 0");
+  m->Add(name("cg_max_iterations"), &o->cg_max_iterations,
+         "lp: cg iteration cap per X-step, >= 1");
   m->Add(name("estimate_iterations"), &o->estimate_iterations,
          "lp: outer iterations that re-estimate sigma, p, theta, >= 1");
   m->Add(name("warm_iterations"), &o->warm_iterations,

@@ -121,6 +121,34 @@ TEST(Denoise, LpRecoversNoisyCube) {
   }
 }
 
+// The conjugate-gradient X-step (default) solves the same problem as the
+// direct one: same parameters, vertices within a small fraction of an edge.
+TEST(Denoise, ConjugateGradientsMatchCholesky) {
+  Eigen::MatrixXd clean, noisy;
+  Eigen::MatrixXi F;
+  NoisyCube(&clean, &noisy, &F);
+  DenoiseOptions cg;
+  DenoiseOptions direct;
+  direct.linear_solver = "cholesky";
+  const DenoiseResult a = Denoise(noisy, F, cg), b = Denoise(noisy, F, direct);
+  ASSERT_EQ(a.iterations.size(), b.iterations.size());
+  for (size_t k = 0; k < a.iterations.size(); ++k) {
+    EXPECT_EQ(a.iterations[k].p, b.iterations[k].p);
+    EXPECT_NEAR(a.iterations[k].lambda, b.iterations[k].lambda, 1e-3 * b.iterations[k].lambda);
+    EXPECT_GT(a.iterations[k].num_cg_iterations, 0);
+    EXPECT_EQ(a.iterations[k].num_cg_unconverged, 0);
+    EXPECT_GT(b.iterations[k].num_factorizations, 0);
+  }
+  const double edge = 2.0 / 24;
+  const double rms = std::sqrt((a.V - b.V).squaredNorm() / a.V.rows());
+  EXPECT_LT(rms, 1e-2 * edge);
+  EXPECT_NEAR(MeanAngleDeg(a.V, clean, F), MeanAngleDeg(b.V, clean, F), 0.05);
+  // A cap of one iteration is reported, not hidden.
+  cg.cg_max_iterations = 1;
+  const DenoiseResult capped = Denoise(noisy, F, cg);
+  EXPECT_GT(capped.iterations[0].num_cg_unconverged, 0);
+}
+
 TEST(Denoise, BaselinesReduceNoise) {
   Eigen::MatrixXd clean, noisy;
   Eigen::MatrixXi F;
