@@ -102,17 +102,8 @@ struct Distances {
 // sample's face normal and the normal of the closest target triangle.
 Distances Query(const std::vector<Sample>& samples, const Eigen::MatrixXd& sample_normals,
                 const Eigen::MatrixXd& V, const Eigen::MatrixXi& F) {
-  std::vector<Triangle> triangles;
-  triangles.reserve(F.rows());
-  for (Eigen::Index f = 0; f < F.rows(); ++f) {
-    const auto p = [&](int k) { return Point(V(F(f, k), 0), V(F(f, k), 1), V(F(f, k), 2)); };
-    triangles.emplace_back(p(0), p(1), p(2));
-  }
   const Eigen::MatrixXd target_normals = FaceNormals(V, F);
-  Tree tree(triangles.cbegin(), triangles.cend());
-  tree.build();
-  tree.accelerate_distance_queries();
-
+  const ClosestPointQuery tree(V, F);
   Distances result;
   const int n = static_cast<int>(samples.size());
   result.distance.resize(n);
@@ -122,12 +113,8 @@ Distances Query(const std::vector<Sample>& samples, const Eigen::MatrixXd& sampl
 #pragma omp parallel for schedule(dynamic, 1024)
 #endif
   for (int i = 0; i < n; ++i) {
-    const Eigen::Vector3d& q = samples[i].point;
-    const Point query(q.x(), q.y(), q.z());
-    const auto closest = tree.closest_point_and_primitive(query);
-    const Eigen::Vector3d c(closest.first.x(), closest.first.y(), closest.first.z());
-    result.distance[i] = (c - q).norm();
-    const int target_face = static_cast<int>(closest.second - triangles.cbegin());
+    int target_face = 0;
+    result.distance[i] = tree.Distance(samples[i].point, &target_face);
     result.target_face[i] = target_face;
     const Eigen::Vector3d a = sample_normals.row(samples[i].face);
     const Eigen::Vector3d b = target_normals.row(target_face);
@@ -148,6 +135,52 @@ double Mean(const std::vector<double>& values) {
 }
 
 }  // namespace
+
+struct ClosestPointQuery::Impl {
+  std::vector<Triangle> triangles;
+  Tree tree;
+};
+
+ClosestPointQuery::ClosestPointQuery(const Eigen::MatrixXd& V, const Eigen::MatrixXi& F)
+    : impl_(new Impl) {
+  MR_CHECK(F.rows() > 0) << "ClosestPointQuery on an empty mesh";
+  impl_->triangles.reserve(F.rows());
+  for (Eigen::Index f = 0; f < F.rows(); ++f) {
+    const auto p = [&](int k) { return Point(V(F(f, k), 0), V(F(f, k), 1), V(F(f, k), 2)); };
+    impl_->triangles.emplace_back(p(0), p(1), p(2));
+  }
+  impl_->tree.insert(impl_->triangles.cbegin(), impl_->triangles.cend());
+  impl_->tree.build();
+  impl_->tree.accelerate_distance_queries();
+}
+
+ClosestPointQuery::~ClosestPointQuery() = default;
+
+double ClosestPointQuery::Distance(const Eigen::Vector3d& q, int* face) const {
+  const auto closest = impl_->tree.closest_point_and_primitive(Point(q.x(), q.y(), q.z()));
+  if (face != nullptr) *face = static_cast<int>(closest.second - impl_->triangles.cbegin());
+  return (Eigen::Vector3d(closest.first.x(), closest.first.y(), closest.first.z()) - q).norm();
+}
+
+SurfaceDisplacement MeasureSurfaceDisplacement(const Eigen::MatrixXd& V,
+                                               const Eigen::MatrixXd& V0,
+                                               const Eigen::MatrixXi& F0) {
+  SurfaceDisplacement d;
+  if (V.rows() == 0 || F0.rows() == 0) return d;
+  const ClosestPointQuery tree(V0, F0);
+  double sum = 0, max = 0;
+#ifdef _OPENMP
+#pragma omp parallel for schedule(dynamic, 1024) reduction(+ : sum) reduction(max : max)
+#endif
+  for (Eigen::Index v = 0; v < V.rows(); ++v) {
+    const double dist = tree.Distance(V.row(v).transpose());
+    sum += dist;
+    max = std::max(max, dist);
+  }
+  d.mean = sum / V.rows();
+  d.max = max;
+  return d;
+}
 
 bool EvaluationOptions::Check() const {
   if (!(threshold > 0) || !std::isfinite(threshold)) {

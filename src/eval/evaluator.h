@@ -3,8 +3,8 @@
 // Mesh accuracy against a ground-truth mesh, Middlebury-style, using exact
 // point-to-triangle distances (CGAL AABB tree) on area-uniform samples.
 
+#include <memory>
 #include <string>
-
 #include <vector>
 
 #include <Eigen/Core>
@@ -44,6 +44,31 @@ EvaluationResult EvaluateMesh(const Eigen::MatrixXd& V, const Eigen::MatrixXi& F
                               const Eigen::MatrixXd& gt_V, const Eigen::MatrixXi& gt_F,
                               const EvaluationOptions& options = {},
                               const std::vector<char>* gt_observed = nullptr);
+
+// Exact closest points on a triangle mesh (CGAL AABB tree, built once).
+// Thread-safe queries.
+class ClosestPointQuery {
+ public:
+  ClosestPointQuery(const Eigen::MatrixXd& V, const Eigen::MatrixXi& F);
+  ~ClosestPointQuery();
+  // Distance from q to the mesh; *face (if given) gets the closest face.
+  double Distance(const Eigen::Vector3d& q, int* face = nullptr) const;
+
+ private:
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+};
+
+// Mean and maximum distance from the vertices of (V, F) to the surface
+// (V0, F0): how far a refinement moved the surface (meaningful across
+// remeshing, unlike per-vertex displacements).
+struct SurfaceDisplacement {
+  double mean = 0;
+  double max = 0;
+};
+SurfaceDisplacement MeasureSurfaceDisplacement(const Eigen::MatrixXd& V,
+                                               const Eigen::MatrixXd& V0,
+                                               const Eigen::MatrixXi& F0);
 
 // Faces of (V, F) visible in at least `min_views` of `views`: the face's
 // centroid faces the camera, lies in the image and is not occluded (depth

@@ -160,6 +160,26 @@ TEST(EvaluateMesh, IdenticalMeshesGiveZero) {
   EXPECT_LT(result.normal_deg, 1e-3);
 }
 
+// Points above the unit square [0,1]^2 at known heights, and one beside it
+// (its distance is to the square's edge, not to the plane).
+TEST(MeasureSurfaceDisplacement, KnownDistances) {
+  const Mesh plane = Plane(4);
+  Eigen::MatrixXd points(3, 3);
+  points << 0.3, 0.4, 0.1,   //
+      0.7, 0.2, -0.3,        //
+      1.3, 0.5, 0.4;         // beside the square: distance hypot(0.3, 0.4) = 0.5
+  const SurfaceDisplacement d = MeasureSurfaceDisplacement(points, plane.V, plane.F);
+  EXPECT_NEAR(d.max, 0.5, 1e-12);
+  EXPECT_NEAR(d.mean, (0.1 + 0.3 + 0.5) / 3, 1e-12);
+  int face = -1;
+  const ClosestPointQuery query(plane.V, plane.F);
+  EXPECT_NEAR(query.Distance(Eigen::Vector3d(0.05, 0.05, 0.2), &face), 0.2, 1e-12);
+  ASSERT_GE(face, 0);  // the corner cell's faces are 0 and 1
+  EXPECT_LE(face, 1);
+  const SurfaceDisplacement none = MeasureSurfaceDisplacement(Eigen::MatrixXd(0, 3), plane.V, plane.F);
+  EXPECT_EQ(none.max, 0);
+}
+
 TEST(EvaluateMesh, TranslatedPlane) {
   const Mesh plane = Plane(8);
   Eigen::MatrixXd moved = plane.V;

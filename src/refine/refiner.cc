@@ -10,6 +10,7 @@
 
 #include <opencv2/imgproc.hpp>
 
+#include "eval/evaluator.h"
 #include "geometry/mesh.h"
 #include "geometry/remesh.h"
 #include "refine/pyramid.h"
@@ -230,6 +231,8 @@ std::string RefineSummary::FullReport() const {
   out << "  views " << num_views << ", pairs " << num_pairs << ", vertices " << initial_vertices
       << " -> " << final_vertices << ", flipped faces fixed " << flipped_faces_fixed
       << ", self-intersections " << self_intersections << "\n";
+  out << "  surface moved: mean " << mean_displacement << ", max " << max_displacement
+      << " (scene units; distance of the result's vertices to the input surface)\n";
   out << "  level iter  faces  similarity  kappa  step_px(mean/max)  regulariser  seconds\n";
   for (const auto& it : iterations) {
     out << "  " << std::setw(5) << it.level << std::setw(5) << it.iteration << std::setw(7)
@@ -272,6 +275,8 @@ RefineSummary RefineMesh(const ViewSource& source, const RefineOptions& options,
     MR_THROW_INPUT << "the input mesh could not be made an oriented 2-manifold ("
                    << clean.BriefReport() << ")";
   }
+  const Eigen::MatrixXd V_input = V;  // for the displacement in the summary
+  const Eigen::MatrixXi F_input = F;
 
   const std::vector<PinholeView> full_views = source.Views();
   if (!(MedianFootprint(full_views, V, VertexNormals(V, F)) > 0)) {
@@ -400,6 +405,9 @@ RefineSummary RefineMesh(const ViewSource& source, const RefineOptions& options,
   }
   summary.final_similarity = FullResolutionSimilarity(source, pairs, similarity, options.pair, V, F,
                                                       renderer, cache_bytes / 2, &images);
+  const SurfaceDisplacement moved = MeasureSurfaceDisplacement(V, V_input, F_input);
+  summary.mean_displacement = moved.mean;
+  summary.max_displacement = moved.max;
   mesh->V = V;
   mesh->F = F;
   mesh->N.resize(0, 3);

@@ -105,6 +105,9 @@ struct RefineSummary {
   double final_similarity = 0;    // and after refinement
   int flipped_faces_fixed = 0;
   int self_intersections = -1;    // of the result (-1: not computed)
+  // Distance of the result's vertices to the (cleaned) input surface, in
+  // scene units: how far the refinement moved the surface.
+  double mean_displacement = 0, max_displacement = 0;
   double seconds = 0;
   std::vector<RefineIteration> iterations;
 
