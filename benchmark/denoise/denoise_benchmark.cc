@@ -82,7 +82,9 @@ class Metric {
 };
 
 // Experiment-only overrides of the lp options from the environment (MAXIT,
-// FIXP, LSCALE, BMAX, B0, FIXL, BF, UPDOP, ESTIT, INNER, CGTOL, SOLVER); unset = defaults. Results in docs/ use none.
+// FIXP, LSCALE, BMAX, B0, FIXL, BF, UPDOP, ESTIT, INNER, CGTOL, SOLVER) and of
+// the l0 options (L0LF, L0B0, L0BMAX, L0K, L0AF, L0AD, L0UPD); unset =
+// defaults. Results in docs/ use none.
 void ApplyEnvOverrides(mr::DenoiseOptions* o) {
   auto env = [](const char* name, double fallback) {
     const char* v = std::getenv(name);
@@ -100,6 +102,13 @@ void ApplyEnvOverrides(mr::DenoiseOptions* o) {
   o->update_operator = env("UPDOP", o->update_operator ? 1 : 0) != 0;
   o->cg_tolerance = env("CGTOL", o->cg_tolerance);
   if (const char* v = std::getenv("SOLVER")) o->linear_solver = v;
+  o->l0_lambda_factor = env("L0LF", o->l0_lambda_factor);
+  o->l0_beta_initial = env("L0B0", o->l0_beta_initial);
+  o->l0_beta_max = env("L0BMAX", o->l0_beta_max);
+  o->l0_beta_factor = env("L0K", o->l0_beta_factor);
+  o->l0_alpha_factor = env("L0AF", o->l0_alpha_factor);
+  o->l0_alpha_decay = env("L0AD", o->l0_alpha_decay);
+  o->l0_update_operator = env("L0UPD", o->l0_update_operator ? 1 : 0) != 0;
 }
 
 double PeakMemoryMiB() {
