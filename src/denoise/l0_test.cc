@@ -24,6 +24,32 @@ void Hinge(double fold_deg, Eigen::MatrixXd* V, Eigen::MatrixXi* F) {
   *F << 0, 1, 2, 1, 0, 3;
 }
 
+// lp_model's EdgeWeights are He & Schaefer's area-based edge operator: the
+// weights of the opposite vertices are S134 / (S123 + S134), S123 / (S123 +
+// S134), and those of the edge ends their dot-product forms, e.g. for x1
+//   (S123 (x4 - x3).(x3 - x1) + S134 (x1 - x3).(x3 - x2)) / (l13^2 (S123 + S134)).
+TEST(EdgeWeights, AreHeSchaefersAreaBasedOperator) {
+  Eigen::MatrixXd V;
+  Eigen::MatrixXi F;
+  SubdividedCube(3, &V, &F);
+  V = AddNormalNoise(V, F, 0.1, 5);
+  const EdgeQuads eq = BuildEdgeQuads(F, static_cast<int>(V.rows()));
+  const Eigen::MatrixXd W = EdgeWeights(V, eq.quads);
+  for (int i = 0; i < eq.quads.rows(); ++i) {
+    const Eigen::Vector3d p1 = V.row(eq.quads(i, 0)), p3 = V.row(eq.quads(i, 1));
+    const Eigen::Vector3d p2 = V.row(eq.quads(i, 2)), p4 = V.row(eq.quads(i, 3));
+    const double s123 = 0.5 * (p2 - p1).cross(p3 - p1).norm();
+    const double s134 = 0.5 * (p4 - p1).cross(p3 - p1).norm();
+    const double l2 = (p3 - p1).squaredNorm(), s = s123 + s134;
+    const double c1 = (s123 * (p4 - p3).dot(p3 - p1) + s134 * (p1 - p3).dot(p3 - p2)) / (l2 * s);
+    const double c3 = (s123 * (p3 - p1).dot(p1 - p4) + s134 * (p2 - p1).dot(p1 - p3)) / (l2 * s);
+    EXPECT_NEAR(W(i, 0), c1, 1e-12) << i;
+    EXPECT_NEAR(W(i, 1), c3, 1e-12) << i;
+    EXPECT_NEAR(W(i, 2), s134 / s, 1e-12) << i;
+    EXPECT_NEAR(W(i, 3), s123 / s, 1e-12) << i;
+  }
+}
+
 TEST(HardThresholdRows, KeepsRowsAtOrAboveTheThreshold) {
   Eigen::MatrixXd rows(5, 3);
   rows << 0.1, 0, 0,  // |r|^2 = 0.01 < 0.04: zeroed
