@@ -131,7 +131,7 @@ struct DenoiseOptions {
   // the weights of the input).
   bool l0_update_operator = true;
 
-  // Log one line per outer iteration at INFO (otherwise VERBOSE).
+  // Log one line per lp outer iteration / l0 beta step at INFO (otherwise VERBOSE).
   bool verbose = false;
 
   // Throws mr::InputError naming the field, its value and the violated bound.
