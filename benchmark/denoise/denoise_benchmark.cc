@@ -1,8 +1,10 @@
 // Denoising benchmark (not a test): quality on the standard protocol and speed.
 //
 //   denoise_benchmark quality [MODELS_DIR]   markdown table on stdout
-//   denoise_benchmark speed NUM_FACES        time + peak memory of lp on a noisy cube
+//   denoise_benchmark speed NUM_FACES [cg|cholesky] [lp|l0]
+//                                            time + peak memory on a noisy cube
 //   denoise_benchmark one MODEL [METHOD]     one model, one method, per-iteration log
+//                                            (METHOD lp | laplacian | bilateral_normal | l0)
 //
 // Protocol: Gaussian noise along the vertex normals with sigma = 0.3 x mean
 // edge length (seed 1) added to a clean mesh. E_a: mean angle (degrees)
@@ -10,6 +12,7 @@
 // mean distance from the result's vertices to the clean surface (exact, AABB
 // tree) divided by the clean mesh's bounding-box diagonal.
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <fstream>
@@ -82,7 +85,9 @@ class Metric {
 };
 
 // Experiment-only overrides of the lp options from the environment (MAXIT,
-// FIXP, LSCALE, BMAX, B0, FIXL, BF, UPDOP, ESTIT, INNER, CGTOL, SOLVER); unset = defaults. Results in docs/ use none.
+// FIXP, LSCALE, BMAX, B0, FIXL, BF, UPDOP, ESTIT, INNER, CGTOL, SOLVER) and of
+// the l0 options (L0LF, L0B0, L0BMAX, L0K, L0AF, L0AD, L0UPD); unset =
+// defaults. Results in docs/ use none.
 void ApplyEnvOverrides(mr::DenoiseOptions* o) {
   auto env = [](const char* name, double fallback) {
     const char* v = std::getenv(name);
@@ -100,6 +105,13 @@ void ApplyEnvOverrides(mr::DenoiseOptions* o) {
   o->update_operator = env("UPDOP", o->update_operator ? 1 : 0) != 0;
   o->cg_tolerance = env("CGTOL", o->cg_tolerance);
   if (const char* v = std::getenv("SOLVER")) o->linear_solver = v;
+  o->l0_lambda_factor = env("L0LF", o->l0_lambda_factor);
+  o->l0_beta_initial = env("L0B0", o->l0_beta_initial);
+  o->l0_beta_max = env("L0BMAX", o->l0_beta_max);
+  o->l0_beta_factor = env("L0K", o->l0_beta_factor);
+  o->l0_alpha_factor = env("L0AF", o->l0_alpha_factor);
+  o->l0_alpha_decay = env("L0AD", o->l0_alpha_decay);
+  o->l0_update_operator = env("L0UPD", o->l0_update_operator ? 1 : 0) != 0;
 }
 
 double PeakMemoryMiB() {
@@ -134,8 +146,8 @@ int Quality(const std::string& models_dir, const std::string& only, const std::s
   std::printf(
       "| model | faces | noisy E_a | noisy E_v | lp E_a | lp E_v | lp s | laplacian(10) E_a | "
       "laplacian best E_a (iters) | laplacian best E_v (iters) | bilateral E_a | bilateral E_v "
-      "| lp p/theta/sigma/lambda (last) |\n");
-  std::printf("|---|---|---|---|---|---|---|---|---|---|---|---|---|\n");
+      "| l0 E_a | l0 E_v | l0 s | lp p/theta/sigma/lambda (last) |\n");
+  std::printf("|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|\n");
   for (const Model& m : models) {
     if (!only.empty() && m.name != only) continue;
     const Metric metric(m.V, m.F);
@@ -174,19 +186,33 @@ int Quality(const std::string& models_dir, const std::string& only, const std::s
     mr::DenoiseOptions bil;
     bil.method = "bilateral_normal";
     const Errors ebil = metric.Evaluate(mr::Denoise(noisy, m.F, bil).V, m.F);
+    mr::DenoiseOptions l0;
+    l0.method = "l0";
+    ApplyEnvOverrides(&l0);
+    const mr::DenoiseResult rl0 = mr::Denoise(noisy, m.F, l0);
+    const Errors el0 = metric.Evaluate(rl0.V, m.F);
     const mr::DenoiseIteration& last = rlp.iterations.back();
+    // Bold: the lowest E_a of the methods run with their defaults (not the
+    // oracle Laplacian column).
+    const double best = std::min(std::min(elp.ea, elap10.ea), std::min(ebil.ea, el0.ea));
+    auto ea = [&](double v) {
+      char buf[32];
+      std::snprintf(buf, sizeof(buf), v == best ? "**%.2f**" : "%.2f", v);
+      return std::string(buf);
+    };
     std::printf(
-        "| %s | %d | %.2f | %.2e | **%.2f** | %.2e | %.2f | %.2f | %.2f (%d) | %.2e (%d) | %.2f | "
-        "%.2e | %.2f / %.3g / %.3g / %.3g (%zu it) |\n",
-        m.name.c_str(), static_cast<int>(m.F.rows()), en.ea, en.ev, elp.ea, elp.ev,
-        rlp.total_seconds, elap10.ea, best_a.ea, best_a_it, best_v.ev, best_v_it, ebil.ea, ebil.ev,
-        last.p, last.theta, last.sigma, last.lambda, rlp.iterations.size());
+        "| %s | %d | %.2f | %.2e | %s | %.2e | %.2f | %s | %.2f (%d) | %.2e (%d) | %s | "
+        "%.2e | %s | %.2e | %.2f | %.2f / %.3g / %.3g / %.3g (%zu it) |\n",
+        m.name.c_str(), static_cast<int>(m.F.rows()), en.ea, en.ev, ea(elp.ea).c_str(), elp.ev,
+        rlp.total_seconds, ea(elap10.ea).c_str(), best_a.ea, best_a_it, best_v.ev, best_v_it,
+        ea(ebil.ea).c_str(), ebil.ev, ea(el0.ea).c_str(), el0.ev, rl0.total_seconds, last.p,
+        last.theta, last.sigma, last.lambda, rlp.iterations.size());
     std::fflush(stdout);
   }
   return 0;
 }
 
-int Speed(long faces, const std::string& linear_solver) {
+int Speed(long faces, const std::string& linear_solver, const std::string& method) {
   const int n = static_cast<int>(std::lround(std::sqrt(faces / 12.0)));
   Eigen::MatrixXd V;
   Eigen::MatrixXi F;
@@ -194,6 +220,7 @@ int Speed(long faces, const std::string& linear_solver) {
   const Eigen::MatrixXd noisy = mr::AddNormalNoise(V, F, 0.3 * 2.0 / n, 1);
   const double before = PeakMemoryMiB();
   mr::DenoiseOptions options;
+  options.method = method;
   options.linear_solver = linear_solver;
   const mr::DenoiseResult r = mr::Denoise(noisy, F, options);
   int factorizations = 0, cg_iterations = 0;
@@ -201,11 +228,18 @@ int Speed(long faces, const std::string& linear_solver) {
     factorizations += it.num_factorizations;
     cg_iterations += it.num_cg_iterations;
   }
-  // faces | vertices | solver | total s | setup s | solve s | outer iterations |
-  // factorisations | cg iterations | peak MiB before | peak MiB after
-  std::printf("| %ld | %ld | %s | %.2f | %.2f | %.2f | %zu | %d | %d | %.0f | %.0f |\n", F.rows(),
-              V.rows(), linear_solver.c_str(), r.total_seconds, r.setup_seconds, r.solve_seconds,
-              r.iterations.size(), factorizations, cg_iterations, before, PeakMemoryMiB());
+  for (const auto& step : r.l0_steps) {
+    if (linear_solver == "cholesky") ++factorizations;
+    cg_iterations += step.num_cg_iterations;
+  }
+  const size_t outer = method == "l0" ? r.l0_steps.size() : r.iterations.size();
+  // faces | vertices | method | solver | total s | setup s | solve s | outer
+  // iterations (l0: beta steps) | factorisations | cg iterations | peak MiB
+  // before | peak MiB after
+  std::printf("| %ld | %ld | %s | %s | %.2f | %.2f | %.2f | %zu | %d | %d | %.0f | %.0f |\n",
+              F.rows(), V.rows(), method.c_str(), linear_solver.c_str(), r.total_seconds,
+              r.setup_seconds, r.solve_seconds, outer, factorizations, cg_iterations, before,
+              PeakMemoryMiB());
   return 0;
 }
 
@@ -219,8 +253,12 @@ int main(int argc, char** argv) {
     if (mode == "one" && argc > 2) {
       return Quality(MR_SHARED_DIR "/data/models", argv[2], argc > 3 ? argv[3] : "lp");
     }
-    if (mode == "speed" && argc > 2) return Speed(std::stol(argv[2]), argc > 3 ? argv[3] : "cg");
-    std::fprintf(stderr, "usage: denoise_benchmark quality [MODELS_DIR] | speed NUM_FACES [cg|cholesky]\n");
+    if (mode == "speed" && argc > 2) {
+      return Speed(std::stol(argv[2]), argc > 3 ? argv[3] : "cg", argc > 4 ? argv[4] : "lp");
+    }
+    std::fprintf(stderr,
+                 "usage: denoise_benchmark quality [MODELS_DIR] | speed NUM_FACES [cg|cholesky] "
+                 "[lp|l0] | one MODEL [METHOD]\n");
     return 1;
   } catch (const std::exception& e) {
     std::fprintf(stderr, "ERROR: %s\n", e.what());

@@ -5,15 +5,10 @@
 #include <cmath>
 #include <sstream>
 
-#include <Eigen/SparseCore>
-#ifdef MR_HAVE_CHOLMOD
-#include <Eigen/CholmodSupport>
-#else
-#include <Eigen/SparseCholesky>
-#endif
-
 #include "denoise/baselines.h"
+#include "denoise/l0.h"
 #include "denoise/lp_model.h"
+#include "denoise/normal_matrix.h"
 #include "util/error.h"
 #include "util/logging.h"
 #include "util/options.h"
@@ -31,183 +26,6 @@ double Now() {
     MR_THROW_INPUT << "DenoiseOptions::" #field " = " << field                         \
                    << ". Violated constraint: " bound;                                 \
   }
-
-using Rows3 = Eigen::Matrix<double, Eigen::Dynamic, 3, Eigen::RowMajor>;
-
-// The lower triangle of I + 2 beta D^T D with a fixed sparsity pattern; the
-// values are refilled when D's weights change or beta changes.
-class NormalMatrix {
- public:
-  NormalMatrix(const Eigen::MatrixXi& quads, int n) : quads_(quads) {
-    std::vector<Eigen::Triplet<double>> t;
-    t.reserve(static_cast<size_t>(quads.rows()) * 10 + n);
-    for (int v = 0; v < n; ++v) t.emplace_back(v, v, 1.0);
-    for (int i = 0; i < quads.rows(); ++i) {
-      for (int a = 0; a < 4; ++a) {
-        for (int b = 0; b < 4; ++b) {
-          const int r = quads(i, a), c = quads(i, b);
-          if (r >= c) t.emplace_back(r, c, 1.0);
-        }
-      }
-    }
-    A_.resize(n, n);
-    A_.setFromTriplets(t.begin(), t.end());
-    A_.makeCompressed();
-    // Position of each (row, a, b) product in A_'s value array (lower part).
-    slots_.resize(static_cast<size_t>(quads.rows()) * 16);
-    for (int i = 0; i < quads.rows(); ++i) {
-      for (int a = 0; a < 4; ++a) {
-        for (int b = 0; b < 4; ++b) {
-          const int r = quads(i, a), c = quads(i, b);
-          slots_[16 * static_cast<size_t>(i) + 4 * a + b] = r >= c ? Find(r, c) : -1;
-        }
-      }
-    }
-    diag_.resize(n);
-    for (int v = 0; v < n; ++v) diag_[v] = Find(v, v);
-    dtd_.assign(A_.nonZeros(), 0.0);
-    // Both triangles, row by row, pointing into the lower triangle's values
-    // (for the row-parallel product of the conjugate-gradient solver).
-    const int* outer = A_.outerIndexPtr();
-    const int* inner = A_.innerIndexPtr();
-    full_outer_.assign(n + 1, 0);
-    for (int c = 0; c < n; ++c) {
-      for (int s = outer[c]; s < outer[c + 1]; ++s) {
-        ++full_outer_[inner[s] + 1];
-        if (inner[s] != c) ++full_outer_[c + 1];
-      }
-    }
-    for (int r = 0; r < n; ++r) full_outer_[r + 1] += full_outer_[r];
-    full_col_.resize(full_outer_[n]);
-    full_slot_.resize(full_outer_[n]);
-    std::vector<int> next(full_outer_.begin(), full_outer_.end() - 1);
-    for (int c = 0; c < n; ++c) {
-      for (int s = outer[c]; s < outer[c + 1]; ++s) {
-        const int r = inner[s];
-        full_col_[next[r]] = c;
-        full_slot_[next[r]++] = s;
-        if (r != c) {
-          full_col_[next[c]] = r;
-          full_slot_[next[c]++] = s;
-        }
-      }
-    }
-  }
-
-  // Recomputes D^T D from the weights.
-  void SetWeights(const Eigen::MatrixXd& W) {
-    std::fill(dtd_.begin(), dtd_.end(), 0.0);
-    for (int i = 0; i < quads_.rows(); ++i) {
-      for (int a = 0; a < 4; ++a) {
-        for (int b = 0; b < 4; ++b) {
-          const int s = slots_[16 * static_cast<size_t>(i) + 4 * a + b];
-          if (s >= 0) dtd_[s] += W(i, a) * W(i, b);
-        }
-      }
-    }
-  }
-
-  // Y = A P with A the symmetric matrix whose lower triangle Matrix() last
-  // filled; P, Y #V by 3, row-major (one row per vertex). Rows in parallel.
-  void Multiply(const Rows3& P, Rows3* Y) const {
-    Y->resize(P.rows(), 3);
-    const double* values = A_.valuePtr();
-#pragma omp parallel for schedule(static) if (P.rows() > 20000)
-    for (int r = 0; r < static_cast<int>(P.rows()); ++r) {
-      Eigen::RowVector3d y = Eigen::RowVector3d::Zero();
-      for (int s = full_outer_[r]; s < full_outer_[r + 1]; ++s) {
-        y += values[full_slot_[s]] * P.row(full_col_[s]);
-      }
-      Y->row(r) = y;
-    }
-  }
-
-  // Diagonal of A (for the Jacobi preconditioner).
-  Eigen::VectorXd Diagonal() const {
-    Eigen::VectorXd d(diag_.size());
-    for (size_t v = 0; v < diag_.size(); ++v) d[v] = A_.valuePtr()[diag_[v]];
-    return d;
-  }
-
-  // A = I + 2 beta D^T D (lower triangle).
-  const Eigen::SparseMatrix<double>& Matrix(double beta) {
-    double* values = A_.valuePtr();
-    for (size_t s = 0; s < dtd_.size(); ++s) values[s] = 2.0 * beta * dtd_[s];
-    for (int d : diag_) values[d] += 1.0;
-    return A_;
-  }
-
- private:
-  int Find(int r, int c) const {
-    const int* begin = A_.innerIndexPtr() + A_.outerIndexPtr()[c];
-    const int* end = A_.innerIndexPtr() + A_.outerIndexPtr()[c + 1];
-    const int* it = std::lower_bound(begin, end, r);
-    MR_CHECK(it != end && *it == r) << "pattern entry missing";
-    return static_cast<int>(it - A_.innerIndexPtr());
-  }
-
-  const Eigen::MatrixXi& quads_;
-  Eigen::SparseMatrix<double> A_;
-  std::vector<int> slots_;
-  std::vector<int> diag_;
-  std::vector<double> dtd_;
-  std::vector<int> full_outer_, full_col_, full_slot_;
-};
-
-#ifdef MR_HAVE_CHOLMOD
-using Cholesky = Eigen::CholmodSupernodalLLT<Eigen::SparseMatrix<double>, Eigen::Lower>;
-#else
-using Cholesky = Eigen::SimplicialLDLT<Eigen::SparseMatrix<double>, Eigen::Lower>;
-#endif
-
-// Solves A X = B (A from normal.Matrix(beta)) by Jacobi-preconditioned
-// conjugate gradients on the three columns at once, warm-started from *X (the
-// previous psi/X step's solution, which is close). Stops when the RMS residual
-// per vertex and coordinate is below `tolerance` (in the normalised units,
-// mean edge = 1; A >= I, so the error is at most the residual), or after
-// max_iterations. Returns the iterations used.
-int SolveCg(const NormalMatrix& normal, const Eigen::MatrixXd& B_in, double tolerance,
-            int max_iterations, Eigen::MatrixXd* X_inout) {
-  // CG on the 3n system (A kron I3) x = b: one step length for all three
-  // columns, so the iterates commute with a rotation of the coordinates.
-  const Rows3 B = B_in;
-  Rows3 X = *X_inout;
-  const Eigen::VectorXd inv_diag = normal.Diagonal().cwiseInverse();
-  Rows3 AX;
-  normal.Multiply(X, &AX);
-  Rows3 R = B - AX;
-  Rows3 Z = R.array().colwise() * inv_diag.array();
-  Rows3 P = Z;
-  double rz = (R.array() * Z.array()).sum();
-  const double target = tolerance * tolerance * static_cast<double>(B.size());
-  Rows3 AP;
-  int k = 0;
-  for (; k < max_iterations; ++k) {
-    if (R.squaredNorm() <= target) break;
-    normal.Multiply(P, &AP);
-    const double pap = (P.array() * AP.array()).sum();
-    if (!(pap > 0)) break;
-    const double alpha = rz / pap;
-    X += alpha * P;
-    R -= alpha * AP;
-    Z = R.array().colwise() * inv_diag.array();
-    const double rz_new = (R.array() * Z.array()).sum();
-    P = Z + (rz_new / rz) * P;
-    rz = rz_new;
-  }
-  *X_inout = X;
-  return k;
-}
-
-// D^T Psi without forming D.
-Eigen::MatrixXd ApplyTranspose(const Eigen::MatrixXi& quads, const Eigen::MatrixXd& W,
-                               const Eigen::MatrixXd& Psi, int n) {
-  Eigen::MatrixXd out = Eigen::MatrixXd::Zero(n, 3);
-  for (int i = 0; i < quads.rows(); ++i) {
-    for (int k = 0; k < 4; ++k) out.row(quads(i, k)) += W(i, k) * Psi.row(i);
-  }
-  return out;
-}
 
 // Robust noise estimate from the rows of D X0 (used where X = X0 makes the
 // closed form zero). D only sees the normal component of a displacement, so
@@ -239,13 +57,9 @@ void DenoiseLp(const Eigen::MatrixXd& V0, const Eigen::MatrixXi& F, const Denois
     return;
   }
   // Normalise: centroid at the origin, unit mean edge length (over face edges).
-  const Eigen::RowVector3d centre = V0.colwise().mean();
+  Eigen::RowVector3d centre;
   double h = 0;
-  for (int f = 0; f < F.rows(); ++f) {
-    for (int k = 0; k < 3; ++k) h += (V0.row(F(f, k)) - V0.row(F(f, (k + 1) % 3))).norm();
-  }
-  h /= 3.0 * F.rows();
-  if (!(h > 0) || !std::isfinite(h)) {
+  if (!NormalizationOf(V0, F, &centre, &h)) {
     result->passed_through = true;
     result->V = V0;
     MR_LOG(WARNING) << "Denoise: all edges have zero length; mesh passed through";
@@ -263,9 +77,9 @@ void DenoiseLp(const Eigen::MatrixXd& V0, const Eigen::MatrixXi& F, const Denois
                     << " degenerate edges";
   }
   NormalMatrix normal(eq.quads, n);
-  Cholesky solver;
+  SparseCholesky solver;
   const bool direct = o.linear_solver == "cholesky";
-  if (direct) solver.analyzePattern(normal.Matrix(1.0));
+  if (direct) solver.Analyze(normal.Matrix(1.0));
   result->setup_seconds = Now() - t0;
 
   const double sigma0 = RobustSigma(ApplyEdgeOperator(eq.quads, W, X0), W);
@@ -337,10 +151,10 @@ void DenoiseLp(const Eigen::MatrixXd& V0, const Eigen::MatrixXi& F, const Denois
         Psi.row(i) = GstShrinkVector(Psi.row(i).transpose(), tau, p).transpose();
       }
       // X-step: (I + 2 beta D^T D) X = X0 + 2 beta D^T psi.
-      const Eigen::MatrixXd rhs = X0 + 2.0 * beta * ApplyTranspose(eq.quads, W, Psi, n);
+      const Eigen::MatrixXd rhs = X0 + 2.0 * beta * ApplyEdgeOperatorTranspose(eq.quads, W, Psi, n);
       if (!direct) {
         if (beta != factored_beta) {
-          normal.Matrix(beta);
+          normal.Matrix(2.0 * beta);
           factored_beta = beta;
         }
         const int used = SolveCg(normal, rhs, o.cg_tolerance, o.cg_max_iterations, &Xk);
@@ -349,12 +163,11 @@ void DenoiseLp(const Eigen::MatrixXd& V0, const Eigen::MatrixXi& F, const Denois
         continue;
       }
       if (beta != factored_beta) {
-        solver.factorize(normal.Matrix(beta));
-        MR_CHECK(solver.info() == Eigen::Success) << "sparse Cholesky failed";
+        solver.Factorize(normal.Matrix(2.0 * beta));
         factored_beta = beta;
         ++it.num_factorizations;
       }
-      Xk = solver.solve(rhs);
+      Xk = solver.Solve(rhs);
     }
     it.change = std::sqrt((Xk - X).squaredNorm() / n);
     X = Xk;
@@ -384,8 +197,9 @@ void DenoiseLp(const Eigen::MatrixXd& V0, const Eigen::MatrixXi& F, const Denois
 }  // namespace
 
 bool DenoiseOptions::Check() const {
-  MR_CHECK_OPTION(method == "lp" || method == "laplacian" || method == "bilateral_normal",
-                  method, "method in {lp, laplacian, bilateral_normal}");
+  MR_CHECK_OPTION(method == "lp" || method == "laplacian" || method == "bilateral_normal" ||
+                      method == "l0",
+                  method, "method in {lp, laplacian, bilateral_normal, l0}");
   MR_CHECK_OPTION(max_iterations >= 1, max_iterations, "max_iterations >= 1");
   MR_CHECK_OPTION(estimate_iterations >= 1, estimate_iterations, "estimate_iterations >= 1");
   MR_CHECK_OPTION(tolerance >= 0, tolerance, "tolerance >= 0");
@@ -414,6 +228,17 @@ bool DenoiseOptions::Check() const {
   MR_CHECK_OPTION(vertex_iterations >= 0, vertex_iterations, "vertex_iterations >= 0");
   MR_CHECK_OPTION(normal_sigma > 0, normal_sigma, "normal_sigma > 0");
   MR_CHECK_OPTION(spatial_sigma > 0, spatial_sigma, "spatial_sigma > 0");
+  MR_CHECK_OPTION(l0_lambda_factor > 0 && std::isfinite(l0_lambda_factor), l0_lambda_factor,
+                  "l0_lambda_factor > 0");
+  MR_CHECK_OPTION(l0_lambda >= 0 && std::isfinite(l0_lambda), l0_lambda, "l0_lambda >= 0");
+  MR_CHECK_OPTION(l0_beta_initial > 0, l0_beta_initial, "l0_beta_initial > 0");
+  MR_CHECK_OPTION(l0_beta_max >= l0_beta_initial && std::isfinite(l0_beta_max), l0_beta_max,
+                  "l0_beta_initial <= l0_beta_max < inf");
+  MR_CHECK_OPTION(l0_beta_factor > 1, l0_beta_factor, "l0_beta_factor > 1");
+  MR_CHECK_OPTION(l0_alpha_factor >= 0 && std::isfinite(l0_alpha_factor), l0_alpha_factor,
+                  "l0_alpha_factor >= 0");
+  MR_CHECK_OPTION(l0_alpha_decay >= 0 && l0_alpha_decay <= 1, l0_alpha_decay,
+                  "0 <= l0_alpha_decay <= 1");
   return true;
 }
 
@@ -425,6 +250,11 @@ std::string DenoiseResult::BriefReport() const {
     const DenoiseIteration& last = iterations.back();
     s << ", " << iterations.size() << " outer iterations, last p = " << last.p
       << ", theta = " << last.theta << ", sigma = " << last.sigma << ", lambda = " << last.lambda;
+  }
+  if (!l0_steps.empty()) {
+    s << ", " << l0_steps.size() << " beta steps, lambda = " << l0_lambda
+      << ", mean dihedral angle = " << l0_mean_dihedral_deg
+      << " deg, non-zero rows at the end = " << l0_steps.back().num_nonzero_rows;
   }
   s << ", " << total_seconds << " s";
   return s.str();
@@ -453,6 +283,8 @@ DenoiseResult Denoise(const Eigen::MatrixXd& V0, const Eigen::MatrixXi& F,
   result.method = options.method;
   if (options.method == "lp") {
     DenoiseLp(V0, F, options, &result);
+  } else if (options.method == "l0") {
+    DenoiseL0(V0, F, options, &result);
   } else if (options.method == "laplacian") {
     result.V = LaplacianSmooth(V0, F, options.laplacian_iterations, options.laplacian_weight,
                                options.bilaplacian_weight);
@@ -468,7 +300,7 @@ DenoiseResult Denoise(const Eigen::MatrixXd& V0, const Eigen::MatrixXi& F,
 
 void RegisterDenoiseOptions(OptionManager* m, DenoiseOptions* o, const std::string& section) {
   auto name = [&](const char* field) { return section + "." + field; };
-  m->Add(name("method"), &o->method, "lp | laplacian | bilateral_normal");
+  m->Add(name("method"), &o->method, "lp | laplacian | bilateral_normal | l0");
   m->Add(name("max_iterations"), &o->max_iterations,
          "lp: outer iterations (parameter estimation + solve), >= 1");
   m->Add(name("tolerance"), &o->tolerance, "lp: stop when RMS change < this (mean edges), >= 0");
@@ -485,11 +317,11 @@ void RegisterDenoiseOptions(OptionManager* m, DenoiseOptions* o, const std::stri
   m->Add(name("inner_iterations"), &o->inner_iterations,
          "lp: psi/X alternations per beta (one factorisation each beta), >= 1");
   m->Add(name("linear_solver"), &o->linear_solver,
-         "lp: X-step solver: cg (warm-started conjugate gradients) | cholesky (CHOLMOD)");
+         "lp, l0: X-step solver: cg (warm-started conjugate gradients) | cholesky (CHOLMOD)");
   m->Add(name("cg_tolerance"), &o->cg_tolerance,
-         "lp: cg stops at this RMS residual (mean edge lengths), > 0");
+         "lp, l0: cg stops at this RMS residual (mean edge lengths), > 0");
   m->Add(name("cg_max_iterations"), &o->cg_max_iterations,
-         "lp: cg iteration cap per X-step, >= 1");
+         "lp, l0: cg iteration cap per X-step, >= 1");
   m->Add(name("estimate_iterations"), &o->estimate_iterations,
          "lp: outer iterations that re-estimate sigma, p, theta, >= 1");
   m->Add(name("warm_iterations"), &o->warm_iterations,
@@ -507,7 +339,20 @@ void RegisterDenoiseOptions(OptionManager* m, DenoiseOptions* o, const std::stri
   m->Add(name("normal_sigma"), &o->normal_sigma, "bilateral_normal: range sigma on |n_i - n_j|");
   m->Add(name("spatial_sigma"), &o->spatial_sigma,
          "bilateral_normal: spatial sigma in mean centroid distances");
-  m->Add(name("verbose"), &o->verbose, "log one line per lp outer iteration");
+  m->Add(name("l0_lambda_factor"), &o->l0_lambda_factor,
+         "l0: lambda = this * mean edge^2 * mean dihedral angle (degrees), > 0");
+  m->Add(name("l0_lambda"), &o->l0_lambda,
+         "l0: if > 0, lambda in scene units^2 instead of the default");
+  m->Add(name("l0_beta_initial"), &o->l0_beta_initial, "l0: first penalty beta, > 0");
+  m->Add(name("l0_beta_max"), &o->l0_beta_max, "l0: last penalty, >= l0_beta_initial");
+  m->Add(name("l0_beta_factor"), &o->l0_beta_factor, "l0: penalty growth per step, > 1");
+  m->Add(name("l0_alpha_factor"), &o->l0_alpha_factor,
+         "l0: regulariser weight = this * mean dihedral angle (degrees) at the first step, >= 0");
+  m->Add(name("l0_alpha_decay"), &o->l0_alpha_decay,
+         "l0: regulariser weight factor per step, [0, 1]");
+  m->Add(name("l0_update_operator"), &o->l0_update_operator,
+         "l0: recompute D's weights from X at every beta step");
+  m->Add(name("verbose"), &o->verbose, "log one line per lp outer iteration / l0 beta step");
 }
 
 }  // namespace mr

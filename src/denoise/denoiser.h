@@ -17,10 +17,13 @@
 //    paper's isotropic baseline), fixed iteration count.
 //  - "bilateral_normal": bilateral normal filtering (Zheng et al. 2011) with
 //    the iterative vertex update of Sun et al. 2007.
+//  - "l0": He & Schaefer 2013 (mesh denoising via L0 minimization): the
+//    number of non-zero rows of D X penalised, solved by hard thresholding
+//    and a beta continuation (denoise/l0.h).
 //
-// Invariance: the lp method works internally on the mesh translated to its
-// centroid and scaled to unit mean edge length, so its result commutes with
-// rotation, translation and uniform scaling of the input.
+// Invariance: the lp and l0 methods work internally on the mesh translated
+// to its centroid and scaled to unit mean edge length, so their results
+// commute with rotation, translation and uniform scaling of the input.
 
 #include <string>
 #include <vector>
@@ -32,7 +35,7 @@ namespace mr {
 class OptionManager;
 
 struct DenoiseOptions {
-  // "lp" | "laplacian" | "bilateral_normal".
+  // "lp" | "laplacian" | "bilateral_normal" | "l0".
   std::string method = "lp";
 
   // ---- lp (content-aware L_p) ----
@@ -65,13 +68,13 @@ struct DenoiseOptions {
   double beta_initial = 2.0;   // > 0
   double beta_max = 100;       // >= beta_initial
   double beta_factor = 2.0;    // > 1
-  // X-step solver. "cg": Jacobi-preconditioned conjugate gradients
+  // X-step solver of lp and l0. "cg": Jacobi-preconditioned conjugate gradients
   // warm-started from the previous step's X (the default: the same result as
   // the direct solver to 0.01 degrees on the benchmark, ~10x faster, half the
   // memory; docs/denoising.md). "cholesky": CHOLMOD supernodal Cholesky, one
   // symbolic analysis per call and one factorisation per beta value.
   std::string linear_solver = "cg";
-  // cg: stop at this RMS residual per coordinate, in mean edge lengths
+  // cg (lp and l0): stop at this RMS residual per coordinate, in mean edge lengths
   // (the matrix is >= I, so the error is at most the residual), > 0.
   double cg_tolerance = 1e-3;
   // cg: iteration cap per X-step (a warning is logged when hit), >= 1.
@@ -100,7 +103,35 @@ struct DenoiseOptions {
   // Spatial sigma, in mean distances between adjacent face centroids, > 0.
   double spatial_sigma = 1.0;
 
-  // Log one line per outer iteration at INFO (otherwise VERBOSE).
+  // ---- l0 (He & Schaefer 2013; also uses linear_solver, cg_tolerance,
+  // cg_max_iterations) ----
+  // min |X - X0|^2 + alpha |R X|^2 + lambda #{e : (D X)_e != 0}, by
+  // alternating delta_e = (D X)_e if |(D X)_e|^2 >= lambda / beta else 0 and
+  // (I + alpha R^T R + beta D^T D) X = X0 + beta D^T delta.
+  // lambda = l0_lambda_factor * l_e^2 * gamma, l_e the mean edge length and
+  // gamma the mean dihedral angle (between adjacent face normals) of the
+  // input in DEGREES (He & Schaefer's default 0.02; docs/denoising.md for why
+  // degrees), > 0.
+  double l0_lambda_factor = 0.02;
+  // If > 0, lambda in the caller's units (length^2) instead, >= 0.
+  double l0_lambda = 0.0;
+  // beta continuation (dimensionless: D's weights are): l0_beta_initial,
+  // * l0_beta_factor, ... while <= l0_beta_max. Paper: 1e-3, sqrt(2), 1e3.
+  double l0_beta_initial = 1e-3;             // > 0
+  double l0_beta_max = 1e3;                  // >= l0_beta_initial
+  double l0_beta_factor = 1.4142135623730951;  // > 1
+  // Regulariser alpha |R X|^2, R(e) = x1 + x3 - x2 - x4 (edge ends minus
+  // opposite vertices: zero on a parallelogram), alpha = l0_alpha_factor *
+  // gamma (degrees) at the first beta step, times l0_alpha_decay at each next
+  // one. Paper: 0.1 and 0.5. l0_alpha_factor >= 0 (0: no regulariser),
+  // l0_alpha_decay in [0, 1].
+  double l0_alpha_factor = 0.1;
+  double l0_alpha_decay = 0.5;
+  // Recompute D's weights from the current X at every beta step (else keep
+  // the weights of the input).
+  bool l0_update_operator = true;
+
+  // Log one line per lp outer iteration / l0 beta step at INFO (otherwise VERBOSE).
   bool verbose = false;
 
   // Throws mr::InputError naming the field, its value and the violated bound.
@@ -120,6 +151,17 @@ struct DenoiseIteration {
   double seconds = 0;
 };
 
+// One beta step of the l0 method.
+struct L0Step {
+  double beta = 0;
+  double alpha = 0;
+  int num_nonzero_rows = 0;    // rows of delta kept by the hard threshold
+  double change = 0;           // RMS vertex displacement of this step / mean edge
+  int num_cg_iterations = 0;   // linear_solver = cg
+  bool cg_unconverged = false; // hit cg_max_iterations
+  double seconds = 0;
+};
+
 struct DenoiseResult {
   Eigen::MatrixXd V;  // #V by 3 denoised positions
   std::string method;
@@ -127,6 +169,11 @@ struct DenoiseResult {
   int num_operator_rows = 0;     // interior manifold edges used in D
   int num_skipped_edges = 0;     // boundary, non-manifold or degenerate
   bool passed_through = false;   // mesh too small: V returned unchanged
+  // l0 only: lambda in the caller's units (length^2), the input's mean
+  // dihedral angle gamma (degrees), one entry per beta step.
+  double l0_lambda = 0;
+  double l0_mean_dihedral_deg = 0;
+  std::vector<L0Step> l0_steps;
   double setup_seconds = 0;      // topology + symbolic analysis
   double solve_seconds = 0;
   double total_seconds = 0;

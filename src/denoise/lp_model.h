@@ -25,9 +25,9 @@ EdgeQuads BuildEdgeQuads(const Eigen::MatrixXi& F, int num_vertices);
 // #rows by 4 weights w such that row i of D X is sum_k w(i,k) X(quads(i,k)):
 //   (A134 x2 + A123 x4) / (A123 + A134) - ((1 - t) x1 + t x3),
 // i.e. the point where segment x2 x4 crosses the edge's line, minus that
-// point's projection on the edge (He & Schaefer's edge-based Laplacian, with
-// the area weights of their Eq. 8 up to a scale). It is zero whenever the
-// two triangles are coplanar. Degenerate rows (zero areas or edge length,
+// point's projection on the edge: exactly He & Schaefer's area-based edge
+// operator, Eq. 8 (test EdgeWeights.AreHeSchaefersAreaBasedOperator). It is
+// zero whenever the two triangles are coplanar. Degenerate rows (zero areas or edge length,
 // or a foot point far outside the edge) get all-zero weights; their count is
 // returned in `num_degenerate` if non-null.
 Eigen::MatrixXd EdgeWeights(const Eigen::MatrixXd& V, const Eigen::MatrixXi& quads,

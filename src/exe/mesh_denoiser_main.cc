@@ -1,7 +1,7 @@
 // mesh_denoiser: denoises a triangle mesh by moving its vertices only.
 //
 //   mesh_denoiser --input_path IN.ply --output_path OUT.ply
-//                 [--Denoise.method lp|laplacian|bilateral_normal] [--Denoise.* ...]
+//                 [--Denoise.method lp|laplacian|bilateral_normal|l0] [--Denoise.* ...]
 //
 // Defaults: the content-aware L_p denoiser of DCV with every parameter
 // estimated from the mesh. Input and output .ply or .obj (by extension);
