@@ -111,34 +111,87 @@ void DataTerm::Add(const DataTerm& other) {
   valid_pixels += other.valid_pixels;
 }
 
-void PredictImage(const MeshGeometry& mesh, const PinholeView& view_i,
-                  const RenderBuffers& render_i, const PinholeView& view_j,
-                  const RenderBuffers& render_j, const cv::Mat& image_j,
-                  const PairTermOptions& options, cv::Mat* predicted, cv::Mat* mask) {
+namespace {
+
+// The warp of view j into view i through the mesh: Î_ij, the valid domain,
+// and, when `derivative` is given, per valid pixel the change of Î per unit
+// motion of the surface along its normal, a = ∇I_jᵀ Jπ_j r / (n·r), and the
+// pixel's footprint d / fx (both CV_64F).
+void WarpImage(const MeshGeometry& mesh, const PinholeView& view_i, const RenderBuffers& render_i,
+               const PinholeView& view_j, const RenderBuffers& render_j, const cv::Mat& image_j,
+               const PairTermOptions& options, cv::Mat* predicted, cv::Mat* mask,
+               cv::Mat* derivative, cv::Mat* footprint) {
   MR_CHECK(image_j.type() == CV_32F) << "image_j must be CV_32F";
   MR_CHECK(render_i.width == view_i.width && render_i.height == view_i.height);
   MR_CHECK(render_j.width == view_j.width && render_j.height == view_j.height);
   *predicted = cv::Mat::zeros(view_i.height, view_i.width, CV_64F);
   *mask = cv::Mat::zeros(view_i.height, view_i.width, CV_8U);
+  if (derivative != nullptr) {
+    *derivative = cv::Mat::zeros(view_i.height, view_i.width, CV_64F);
+    *footprint = cv::Mat::zeros(view_i.height, view_i.width, CV_64F);
+  }
 #pragma omp parallel for schedule(dynamic, 8)
   for (int row = 0; row < view_i.height; ++row) {
     PixelWarp warp;
     for (int col = 0; col < view_i.width; ++col) {
       if (!WarpPixel(mesh, view_i, render_i, view_j, render_j, options, row, col, &warp)) continue;
-      predicted->at<double>(row, col) = SampleBilinear(image_j, warp.q.x(), warp.q.y(), nullptr);
       mask->at<uint8_t>(row, col) = 255;
+      if (derivative == nullptr) {
+        predicted->at<double>(row, col) = SampleBilinear(image_j, warp.q.x(), warp.q.y(), nullptr);
+        continue;
+      }
+      Eigen::Vector2d grad_j;
+      predicted->at<double>(row, col) = SampleBilinear(image_j, warp.q.x(), warp.q.y(), &grad_j);
+      const int f = render_i.face_id[static_cast<size_t>(row) * render_i.width + col];
+      const Eigen::Vector3d n = mesh.face_normals.row(f);
+      derivative->at<double>(row, col) = grad_j.dot(warp.jacobian_j * warp.ray) / n.dot(warp.ray);
+      footprint->at<double>(row, col) = warp.depth / view_i.fx;
     }
   }
 }
 
-long AccumulatePairTerm(const MeshGeometry& mesh, const PinholeView& view_i,
-                        const RenderBuffers& render_i, const cv::Mat& image_i,
-                        const PinholeView& view_j, const RenderBuffers& render_j,
-                        const cv::Mat& image_j, const SimilarityOptions& similarity,
-                        const PairTermOptions& options, DataTerm* term) {
-  MR_CHECK(term->gradient.rows() == mesh.V->rows()) << "DataTerm not sized for the mesh";
-  cv::Mat predicted, mask;
-  PredictImage(mesh, view_i, render_i, view_j, render_j, image_j, options, &predicted, &mask);
+int NumThreads() {
+#ifdef _OPENMP
+  return std::max(1, omp_get_max_threads());
+#else
+  return 1;
+#endif
+}
+
+int ThreadIndex() {
+#ifdef _OPENMP
+  return omp_get_thread_num();
+#else
+  return 0;
+#endif
+}
+
+}  // namespace
+
+void PredictImage(const MeshGeometry& mesh, const PinholeView& view_i,
+                  const RenderBuffers& render_i, const PinholeView& view_j,
+                  const RenderBuffers& render_j, const cv::Mat& image_j,
+                  const PairTermOptions& options, cv::Mat* predicted, cv::Mat* mask) {
+  WarpImage(mesh, view_i, render_i, view_j, render_j, image_j, options, predicted, mask, nullptr,
+            nullptr);
+}
+
+DataTermAccumulator::DataTermAccumulator(int num_vertices)
+    : num_vertices_(num_vertices), partial_(NumThreads()) {
+  for (auto& p : partial_) p.Reset(num_vertices);
+}
+
+long DataTermAccumulator::AddPair(const MeshGeometry& mesh, const PinholeView& view_i,
+                                  const RenderBuffers& render_i, const cv::Mat& image_i,
+                                  const PinholeView& view_j, const RenderBuffers& render_j,
+                                  const cv::Mat& image_j, const SimilarityOptions& similarity,
+                                  const PairTermOptions& options) {
+  MR_CHECK(mesh.V->rows() == num_vertices_) << "DataTermAccumulator not sized for the mesh";
+  MR_CHECK(static_cast<int>(partial_.size()) >= NumThreads())
+      << "DataTermAccumulator used with more threads than it was made for";
+  cv::Mat predicted, mask, derivative, footprint;
+  WarpImage(mesh, view_i, render_i, view_j, render_j, image_j, options, &predicted, &mask,
+            &derivative, &footprint);
   const long valid = cv::countNonZero(mask);
   if (valid == 0) return 0;
 
@@ -150,47 +203,32 @@ long AccumulatePairTerm(const MeshGeometry& mesh, const PinholeView& view_i,
     predicted.convertTo(predicted, CV_32F);
   }
   const SimilarityResult maps = ComputeSimilarity(observed, predicted, mask, similarity);
-  term->cost += maps.cost;
-  term->zncc_sum += maps.zncc_sum;
-  term->weight_sum += maps.weight_sum;
-  term->valid_pixels += valid;
+  DataTerm& scalars = partial_[0];
+  scalars.cost += maps.cost;
+  scalars.zncc_sum += maps.zncc_sum;
+  scalars.weight_sum += maps.weight_sum;
+  scalars.valid_pixels += valid;
   const bool dp = maps.gradient.depth() == CV_64F;
 
   const Eigen::MatrixXi& F = *mesh.F;
   const int height = view_i.height, width = view_i.width;
-  // Rows are processed in two interleaved halves so that the per-vertex
-  // scatter needs no atomics: each thread owns a private accumulator.
-  const int num_threads =
-#ifdef _OPENMP
-      std::max(1, omp_get_max_threads());
-#else
-      1;
-#endif
-  std::vector<DataTerm> partial(num_threads);
-  for (auto& p : partial) p.Reset(static_cast<int>(mesh.V->rows()));
-#pragma omp parallel for schedule(dynamic, 8)
+  // Each thread scatters into its own buffer, so no atomics are needed. A
+  // static schedule gives every thread the same rows in every run, so the
+  // sums (and the refinement) are reproducible for a given thread count.
+#pragma omp parallel for schedule(static)
   for (int row = 0; row < height; ++row) {
-#ifdef _OPENMP
-    DataTerm& acc = partial[omp_get_thread_num()];
-#else
-    DataTerm& acc = partial[0];
-#endif
-    PixelWarp warp;
+    DataTerm& acc = partial_[ThreadIndex()];
+    const uint8_t* valid_row = mask.ptr<uint8_t>(row);
     for (int col = 0; col < width; ++col) {
-      if (mask.at<uint8_t>(row, col) == 0) continue;
-      if (!WarpPixel(mesh, view_i, render_i, view_j, render_j, options, row, col, &warp)) continue;
+      if (valid_row[col] == 0) continue;
       const size_t idx = static_cast<size_t>(row) * width + col;
       const int f = render_i.face_id[idx];
       const Eigen::Vector3d n = mesh.face_normals.row(f);
-      Eigen::Vector2d grad_j;
-      SampleBilinear(image_j, warp.q.x(), warp.q.y(), &grad_j);
-      const double n_dot_r = n.dot(warp.ray);
-      // a = ∇I_jᵀ Jπ_j r / (n·r): intensity change per unit normal motion.
-      const double a = grad_j.dot(warp.jacobian_j * warp.ray) / n_dot_r;
+      const double a = derivative.at<double>(row, col);
       const double g = dp ? maps.gradient.at<double>(row, col) : maps.gradient.at<float>(row, col);
       const double v2 = dp ? maps.variance_predicted.at<double>(row, col)
                            : maps.variance_predicted.at<float>(row, col);
-      const double footprint = warp.depth / view_i.fx;
+      const double pixel_footprint = footprint.at<double>(row, col);
       const double u = render_i.bary[2 * idx], v = render_i.bary[2 * idx + 1];
       const double w[3] = {1.0 - u - v, u, v};
       for (int k = 0; k < 3; ++k) {
@@ -198,16 +236,30 @@ long AccumulatePairTerm(const MeshGeometry& mesh, const PinholeView& view_i,
         acc.gradient.row(vk) += (w[k] * g * a) * n.transpose();
         acc.curvature(vk) += w[k] * a * a / v2;
         acc.weight(vk) += w[k];
-        acc.footprint(vk) += w[k] * footprint;
+        acc.footprint(vk) += w[k] * pixel_footprint;
       }
     }
   }
-  for (const auto& p : partial) {
-    term->gradient += p.gradient;
-    term->curvature += p.curvature;
-    term->weight += p.weight;
-    term->footprint += p.footprint;
-  }
+  return valid;
+}
+
+DataTerm DataTermAccumulator::Sum() const {
+  DataTerm sum;
+  sum.Reset(num_vertices_);
+  for (const auto& p : partial_) sum.Add(p);
+  return sum;
+}
+
+long AccumulatePairTerm(const MeshGeometry& mesh, const PinholeView& view_i,
+                        const RenderBuffers& render_i, const cv::Mat& image_i,
+                        const PinholeView& view_j, const RenderBuffers& render_j,
+                        const cv::Mat& image_j, const SimilarityOptions& similarity,
+                        const PairTermOptions& options, DataTerm* term) {
+  MR_CHECK(term->gradient.rows() == mesh.V->rows()) << "DataTerm not sized for the mesh";
+  DataTermAccumulator accumulator(static_cast<int>(mesh.V->rows()));
+  const long valid = accumulator.AddPair(mesh, view_i, render_i, image_i, view_j, render_j,
+                                         image_j, similarity, options);
+  term->Add(accumulator.Sum());
   return valid;
 }
 

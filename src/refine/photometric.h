@@ -26,6 +26,8 @@
 // 1 - ZNCC with respect to one predicted pixel near a match). The refiner
 // steps by -G_k / H_k, which is invariant to the scale of the scene.
 
+#include <vector>
+
 #include <opencv2/core.hpp>
 
 #include <Eigen/Core>
@@ -78,8 +80,30 @@ void PredictImage(const MeshGeometry& mesh, const PinholeView& view_i,
                   const RenderBuffers& render_j, const cv::Mat& image_j,
                   const PairTermOptions& options, cv::Mat* predicted, cv::Mat* mask);
 
+// Sums the data terms of many ordered pairs. The per-vertex sums are kept in
+// one buffer per thread, allocated once and reused for every pair (a #V-sized
+// allocation per pair and thread cost more than the pair's pixels on large
+// meshes), and reduced by Sum().
+class DataTermAccumulator {
+ public:
+  explicit DataTermAccumulator(int num_vertices);
+  // Adds the data term of the ordered pair (i, j). Returns its number of
+  // valid pixels.
+  long AddPair(const MeshGeometry& mesh, const PinholeView& view_i, const RenderBuffers& render_i,
+               const cv::Mat& image_i, const PinholeView& view_j, const RenderBuffers& render_j,
+               const cv::Mat& image_j, const SimilarityOptions& similarity,
+               const PairTermOptions& options);
+  // The sum over the pairs added so far.
+  DataTerm Sum() const;
+
+ private:
+  int num_vertices_;
+  std::vector<DataTerm> partial_;  // one per thread
+};
+
 // Adds the data term of the ordered pair (i, j) to `term` (sized for the mesh).
-// Returns the number of valid pixels.
+// Returns the number of valid pixels. For many pairs, DataTermAccumulator is
+// cheaper.
 long AccumulatePairTerm(const MeshGeometry& mesh, const PinholeView& view_i,
                         const RenderBuffers& render_i, const cv::Mat& image_i,
                         const PinholeView& view_j, const RenderBuffers& render_j,

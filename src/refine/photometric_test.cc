@@ -28,10 +28,11 @@ double PairCost(const Eigen::MatrixXd& V, const Eigen::MatrixXi& F, const Pinhol
                 const SimilarityOptions& similarity, DataTerm* term) {
   MeshGeometry mesh{&V, &F, FaceNormals(V, F)};
   const RenderBuffers ra = RenderCpu(V, F, a), rb = RenderCpu(V, F, b);
-  term->Reset(static_cast<int>(V.rows()));
   PairTermOptions options;
-  AccumulatePairTerm(mesh, a, ra, image_a, b, rb, image_b, similarity, options, term);
-  AccumulatePairTerm(mesh, b, rb, image_b, a, ra, image_a, similarity, options, term);
+  DataTermAccumulator accumulator(static_cast<int>(V.rows()));
+  accumulator.AddPair(mesh, a, ra, image_a, b, rb, image_b, similarity, options);
+  accumulator.AddPair(mesh, b, rb, image_b, a, ra, image_a, similarity, options);
+  *term = accumulator.Sum();
   return term->cost;
 }
 
@@ -95,6 +96,43 @@ TEST(PairTerm, VertexGradientMatchesFiniteDifferences) {
     }
     EXPECT_EQ(checked, 6);
   }
+}
+
+// The accumulator's sum over two pairs equals the two pair terms added one by
+// one (the per-thread buffers are reused, not reset, between pairs).
+TEST(PairTerm, AccumulatorEqualsSumOfPairTerms) {
+  Eigen::MatrixXd V;
+  Eigen::MatrixXi F;
+  HeightField(&V, &F);
+  const PinholeView a = LookAtView(Eigen::Vector3d(-0.3, 0, 4), Eigen::Vector3d::Zero(),
+                                   Eigen::Vector3d(0, 1, 0), 40, 32, 40);
+  const PinholeView b = LookAtView(Eigen::Vector3d(0.4, 0.2, 4), Eigen::Vector3d::Zero(),
+                                   Eigen::Vector3d(0, 1, 0), 40, 32, 40);
+  const cv::Mat image_a = SmoothImage(40, 32, 0.0), image_b = SmoothImage(40, 32, 0.7);
+  SimilarityOptions similarity;
+  DataTerm summed;
+  PairCost(V, F, a, b, image_a, image_b, similarity, &summed);
+
+  MeshGeometry mesh{&V, &F, FaceNormals(V, F)};
+  const RenderBuffers ra = RenderCpu(V, F, a), rb = RenderCpu(V, F, b);
+  DataTerm one_by_one;
+  one_by_one.Reset(static_cast<int>(V.rows()));
+  const PairTermOptions options;
+  const long valid_ab =
+      AccumulatePairTerm(mesh, a, ra, image_a, b, rb, image_b, similarity, options, &one_by_one);
+  const long valid_ba =
+      AccumulatePairTerm(mesh, b, rb, image_b, a, ra, image_a, similarity, options, &one_by_one);
+  ASSERT_GT(valid_ab, 100);
+  ASSERT_GT(valid_ba, 100);
+  EXPECT_EQ(summed.valid_pixels, valid_ab + valid_ba);
+  EXPECT_EQ(one_by_one.valid_pixels, valid_ab + valid_ba);
+  EXPECT_NEAR(summed.cost, one_by_one.cost, 1e-9 * std::abs(one_by_one.cost));
+  EXPECT_GT(one_by_one.gradient.norm(), 0);
+  EXPECT_LT((summed.gradient - one_by_one.gradient).norm(), 1e-9 * one_by_one.gradient.norm());
+  EXPECT_LT((summed.curvature - one_by_one.curvature).norm(), 1e-9 * one_by_one.curvature.norm());
+  EXPECT_LT((summed.weight - one_by_one.weight).norm(), 1e-9 * one_by_one.weight.norm());
+  EXPECT_LT((summed.footprint - one_by_one.footprint).norm(),
+            1e-9 * one_by_one.footprint.norm());
 }
 
 }  // namespace
