@@ -8,7 +8,8 @@
 //
 // mr::InputError (bad input: files, flags, workspaces) prints one line
 // "ERROR: <what>"; any other exception "ERROR (internal): <what>". Both
-// return exit status 1.
+// return exit status 1. It also sets glibc to reuse freed multi-MB buffers
+// instead of returning them to the kernel at once (see program.cc).
 
 #include <functional>
 
