@@ -11,6 +11,8 @@
 #include <utility>
 #include <vector>
 
+#include <CGAL/Bbox_3.h>
+#include <CGAL/box_intersection_d.h>
 #include <CGAL/Exact_predicates_inexact_constructions_kernel.h>
 #include <CGAL/Surface_mesh.h>
 #include <CGAL/exceptions.h>
@@ -423,6 +425,132 @@ RemoveSelfIntersectionsSummary RemoveSelfIntersections(
     MR_LOG(WARNING) << "RemoveSelfIntersections: " << summary.final_pairs
                     << " intersecting face pairs remain";
   }
+  return summary;
+}
+
+namespace {
+
+// The intersecting face pairs (a < b, sorted) that involve at least one face
+// of `faces`: CGAL's test on the range made of those faces and of every face
+// whose bounding box overlaps one of theirs (box_intersection_d), so that no
+// pair with a face of `faces` is missed and the rest of the mesh is skipped.
+std::vector<std::pair<int, int>> IntersectingPairsInvolving(const Eigen::MatrixXd& V,
+                                                            const Eigen::MatrixXi& F,
+                                                            const std::vector<int>& faces) {
+  using Box = CGAL::Box_intersection_d::Box_with_info_d<double, 3, int>;
+  auto face_box = [&](int f) {
+    CGAL::Bbox_3 b;
+    for (int k = 0; k < 3; ++k) {
+      const Eigen::Vector3d p = V.row(F(f, k));
+      b += CGAL::Bbox_3(p.x(), p.y(), p.z(), p.x(), p.y(), p.z());
+    }
+    return Box(b, f);
+  };
+  std::vector<Box> queries, all;
+  for (int f : faces) queries.push_back(face_box(f));
+  all.reserve(F.rows());
+  for (int f = 0; f < F.rows(); ++f) all.push_back(face_box(f));
+  std::vector<char> in_range(F.rows(), 0);
+  for (int f : faces) in_range[f] = 1;
+  CGAL::box_intersection_d(queries.begin(), queries.end(), all.begin(), all.end(),
+                           [&](const Box&, const Box& b) { in_range[b.info()] = 1; });
+  const Mesh mesh = ToCgal(V, F, "UndoSelfIntersections");
+  std::vector<Mesh::Face_index> range;
+  for (int f = 0; f < F.rows(); ++f) {
+    if (in_range[f]) range.push_back(Mesh::Face_index(f));
+  }
+  std::vector<std::pair<Mesh::Face_index, Mesh::Face_index>> found;
+  RunCgal("UndoSelfIntersections", [&] {
+    PMP::self_intersections<CGAL::Parallel_if_available_tag>(range, mesh,
+                                                             std::back_inserter(found));
+  });
+  std::vector<std::pair<int, int>> pairs;
+  for (const auto& p : found) {
+    const int a = static_cast<int>(p.first.idx()), b = static_cast<int>(p.second.idx());
+    pairs.emplace_back(std::min(a, b), std::max(a, b));
+  }
+  std::sort(pairs.begin(), pairs.end());
+  return pairs;
+}
+
+}  // namespace
+
+std::string UndoSelfIntersectionsSummary::BriefReport() const {
+  std::ostringstream s;
+  s << "new intersecting pairs " << initial_pairs << " undone by resetting " << reset_vertices
+    << " vertices in " << rounds << " rounds (" << initial_flipped
+    << " faces folded by the resets, undone too), " << seconds << " s";
+  return s.str();
+}
+
+UndoSelfIntersectionsSummary UndoSelfIntersections(
+    const Eigen::MatrixXd& V_before, const Eigen::MatrixXi& F,
+    const std::vector<std::pair<int, int>>& allowed, Eigen::MatrixXd* V_after) {
+  MR_CHECK(V_after != nullptr);
+  CheckMeshInput(V_before, F, "UndoSelfIntersections");
+  CheckMeshInput(*V_after, F, "UndoSelfIntersections");
+  if (V_before.rows() != V_after->rows()) {
+    MR_THROW_INPUT << "UndoSelfIntersections: V_before has " << V_before.rows()
+                   << " vertices, V_after " << V_after->rows();
+  }
+  MR_CHECK(std::is_sorted(allowed.begin(), allowed.end()));
+  const double t0 = ElapsedSeconds();
+  UndoSelfIntersectionsSummary summary;
+  std::vector<char> reset(V_after->rows(), 0);
+  // Faces with a vertex reset in the last round: after the first (whole
+  // mesh) check, new pairs can only involve these.
+  std::vector<int> changed_faces;
+  std::vector<std::vector<int>> vertex_faces;
+  for (bool first = true;; first = false) {
+    const std::vector<std::pair<int, int>> pairs =
+        first ? CountSelfIntersections(*V_after, F, true).pairs
+              : IntersectingPairsInvolving(*V_after, F, changed_faces);
+    std::vector<int> faces;
+    long new_pairs = 0;
+    for (const auto& p : pairs) {
+      if (std::binary_search(allowed.begin(), allowed.end(), p)) continue;
+      ++new_pairs;
+      faces.push_back(p.first);
+      faces.push_back(p.second);
+    }
+    const std::vector<int> flipped = FlippedFaces(V_before, *V_after, F);
+    faces.insert(faces.end(), flipped.begin(), flipped.end());
+    if (first) summary.initial_pairs = new_pairs;
+    summary.initial_flipped += static_cast<int>(flipped.size());
+    if (faces.empty()) break;
+    ++summary.rounds;
+    if (vertex_faces.empty()) {
+      vertex_faces.resize(V_after->rows());
+      for (int f = 0; f < F.rows(); ++f) {
+        for (int k = 0; k < 3; ++k) vertex_faces[F(f, k)].push_back(f);
+      }
+    }
+    int newly_reset = 0;
+    changed_faces.clear();
+    for (int f : faces) {
+      for (int k = 0; k < 3; ++k) {
+        const int v = F(f, k);
+        if (reset[v]) continue;
+        reset[v] = 1;
+        V_after->row(v) = V_before.row(v);
+        ++newly_reset;
+        changed_faces.insert(changed_faces.end(), vertex_faces[v].begin(), vertex_faces[v].end());
+      }
+    }
+    std::sort(changed_faces.begin(), changed_faces.end());
+    changed_faces.erase(std::unique(changed_faces.begin(), changed_faces.end()),
+                        changed_faces.end());
+    summary.reset_vertices += newly_reset;
+    // Cannot happen when V_before has no pair outside `allowed` (see the
+    // header); then the offending pairs were already in V_before.
+    if (newly_reset == 0) {
+      MR_LOG(WARNING) << "UndoSelfIntersections: " << new_pairs
+                      << " intersecting pairs were already in V_before; left as they are";
+      break;
+    }
+  }
+  summary.seconds = ElapsedSeconds() - t0;
+  MR_LOG(VERBOSE) << "UndoSelfIntersections: " << summary.BriefReport();
   return summary;
 }
 

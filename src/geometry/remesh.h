@@ -217,6 +217,30 @@ RemoveSelfIntersectionsSummary RemoveSelfIntersections(
     Eigen::MatrixXd* V, Eigen::MatrixXi* F,
     const RemoveSelfIntersectionsOptions& options = RemoveSelfIntersectionsOptions());
 
+struct UndoSelfIntersectionsSummary {
+  long initial_pairs = 0;   // intersecting pairs in the given *V_after, not counting `allowed`
+  int initial_flipped = 0;  // flipped faces created by the resets (undone as well)
+  int rounds = 0;           // checks that found something to undo
+  int reset_vertices = 0;   // vertices moved back to V_before
+  double seconds = 0;
+  std::string BriefReport() const;
+};
+
+// Prevents a motion from creating self-intersections: the vertices of every
+// face pair that intersects in *V_after but is not in `allowed` (sorted pairs
+// a < b, e.g. those V_before already had; may be empty) are reset to their
+// V_before positions, and so are those of faces flipped against V_before
+// (a partial reset can fold a face), repeated until neither is left. This
+// terminates: a round that finds something resets at least one vertex not
+// yet reset, because a face pair whose six vertices are all back at V_before
+// is a pair of V_before. The first check covers the whole mesh (CGAL), the
+// later ones only the faces around reset vertices and what their bounding
+// boxes overlap. Needs an oriented 2-manifold; V_before and *V_after
+// have the same shape. In place.
+UndoSelfIntersectionsSummary UndoSelfIntersections(
+    const Eigen::MatrixXd& V_before, const Eigen::MatrixXi& F,
+    const std::vector<std::pair<int, int>>& allowed, Eigen::MatrixXd* V_after);
+
 // ---------------------------------------------------------------------------
 // Flipped faces (Eigen only): faces whose normal turned by more than
 // `max_angle_deg` (default 90 degrees, i.e. n_before . n_after < 0) between

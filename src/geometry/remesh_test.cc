@@ -3,6 +3,8 @@
 
 #include <gtest/gtest.h>
 
+#include <random>
+
 #include <algorithm>
 #include <cmath>
 #include <cstdlib>
@@ -486,6 +488,78 @@ TEST(SelfIntersections, RemoveWithCgalRepair) {
   EXPECT_TRUE(s.cgal_repair_used);
   EXPECT_EQ(s.final_pairs, 0);
   EXPECT_EQ(CountSelfIntersections(V, F).intersecting_pairs, 0);
+}
+
+TEST(SelfIntersections, UndoResetsOnlyWhatIntersects) {
+  Eigen::MatrixXd V;
+  Eigen::MatrixXi F;
+  Icosphere(3, &V, &F);
+  // Every vertex moves a little outwards (harmless), vertex 0 through the
+  // sphere to the other side (intersects).
+  Eigen::MatrixXd W = 1.01 * V;
+  W.row(0) = -1.5 * V.row(0);
+  ASSERT_GT(CountSelfIntersections(W, F).intersecting_pairs, 0);
+  const UndoSelfIntersectionsSummary s = UndoSelfIntersections(V, F, {}, &W);
+  EXPECT_GT(s.initial_pairs, 0);
+  EXPECT_GE(s.rounds, 1);
+  EXPECT_EQ(CountSelfIntersections(W, F).intersecting_pairs, 0);
+  EXPECT_EQ(CountFlippedFaces(V, W, F), 0);
+  EXPECT_EQ(W.row(0), V.row(0));
+  // Only vertex 0 and vertices of the faces it pierced were reset; the rest
+  // kept their motion.
+  int kept = 0;
+  for (int v = 0; v < V.rows(); ++v) kept += W.row(v) == (1.01 * V.row(v)) ? 1 : 0;
+  EXPECT_EQ(kept + s.reset_vertices, V.rows());
+  EXPECT_LT(s.reset_vertices, 20);
+  EXPECT_GT(kept, V.rows() - 20);
+}
+
+TEST(SelfIntersections, UndoLeavesNoneAfterManyWildMoves) {
+  // Many large random moves; resets of some create pairs with others, which
+  // the later (local) rounds must find: the full check of the result agrees.
+  Eigen::MatrixXd V;
+  Eigen::MatrixXi F;
+  Icosphere(3, &V, &F);
+  std::mt19937 rng(7);
+  std::uniform_int_distribution<int> pick(0, static_cast<int>(V.rows()) - 1);
+  std::normal_distribution<double> normal(0.0, 0.6);
+  int most_rounds = 0;
+  for (int trial = 0; trial < 5; ++trial) {
+    Eigen::MatrixXd W = V;
+    for (int i = 0; i < 40; ++i) {
+      W.row(pick(rng)) += Eigen::RowVector3d(normal(rng), normal(rng), normal(rng));
+    }
+    ASSERT_GT(CountSelfIntersections(W, F).intersecting_pairs, 0) << "trial " << trial;
+    const UndoSelfIntersectionsSummary s = UndoSelfIntersections(V, F, {}, &W);
+    EXPECT_GT(s.initial_pairs, 0);
+    EXPECT_EQ(CountSelfIntersections(W, F).intersecting_pairs, 0) << "trial " << trial;
+    EXPECT_EQ(CountFlippedFaces(V, W, F), 0) << "trial " << trial;
+    most_rounds = std::max(most_rounds, s.rounds);
+  }
+  EXPECT_GE(most_rounds, 2);  // the local rounds did run
+}
+
+TEST(SelfIntersections, UndoKeepsAllowedPairs) {
+  // A mesh that already intersects: its pairs are allowed, so a harmless
+  // motion is kept entirely; without the allowance the warning path stops.
+  Eigen::MatrixXd V;
+  Eigen::MatrixXi F;
+  PiercedSphere(&V, &F);
+  const SelfIntersectionReport before = CountSelfIntersections(V, F, true);
+  ASSERT_GT(before.intersecting_pairs, 0);
+  const Eigen::MatrixXd moved = 1.001 * V;
+  Eigen::MatrixXd W = moved;
+  const UndoSelfIntersectionsSummary s = UndoSelfIntersections(V, F, before.pairs, &W);
+  EXPECT_EQ(s.initial_pairs, 0);
+  EXPECT_EQ(s.reset_vertices, 0);
+  EXPECT_EQ(W, moved);
+  W = moved;
+  const UndoSelfIntersectionsSummary t = UndoSelfIntersections(V, F, {}, &W);
+  EXPECT_EQ(t.initial_pairs, before.intersecting_pairs);
+  EXPECT_GT(t.reset_vertices, 0);
+  EXPECT_THROW(UndoSelfIntersections(V, F, {}, nullptr), std::exception);
+  Eigen::MatrixXd short_v = V.topRows(5);
+  EXPECT_THROW(UndoSelfIntersections(V, F, {}, &short_v), InputError);
 }
 
 // A flat 3x3 vertex grid on z = 0 (8 triangles, CCW seen from +z); the

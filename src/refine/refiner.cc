@@ -114,18 +114,17 @@ DataTerm ComputeDataTerm(const MeshGeometry& mesh, const std::vector<PinholeView
                          const std::vector<std::pair<int, int>>& pairs, int level,
                          const SimilarityOptions& similarity, const PairTermOptions& pair_options,
                          RenderCache* renders, ImageCache* images) {
-  DataTerm term;
-  term.Reset(static_cast<int>(mesh.V->rows()));
+  DataTermAccumulator accumulator(static_cast<int>(mesh.V->rows()));
   for (const auto& [a, b] : pairs) {
     for (int dir = 0; dir < 2; ++dir) {
       const int i = dir == 0 ? a : b, j = dir == 0 ? b : a;
       const auto render_i = renders->Get(i);
       const auto render_j = renders->Get(j);
-      AccumulatePairTerm(mesh, views[i], *render_i, images->Gray(i, level), views[j], *render_j,
-                         images->Gray(j, level), similarity, pair_options, &term);
+      accumulator.AddPair(mesh, views[i], *render_i, images->Gray(i, level), views[j], *render_j,
+                          images->Gray(j, level), similarity, pair_options);
     }
   }
-  return term;
+  return accumulator.Sum();
 }
 
 // Mean plain-ZNCC similarity of all pairs at full resolution through (V, F).
@@ -230,7 +229,8 @@ std::string RefineSummary::FullReport() const {
   out << BriefReport() << "\n";
   out << "  views " << num_views << ", pairs " << num_pairs << ", vertices " << initial_vertices
       << " -> " << final_vertices << ", flipped faces fixed " << flipped_faces_fixed
-      << ", self-intersections " << self_intersections << "\n";
+      << ", intersecting pairs undone " << self_intersections_undone << " (" << vertices_reset
+      << " vertex moves reset), self-intersections left " << self_intersections << "\n";
   out << "  surface moved: mean " << mean_displacement << ", max " << max_displacement
       << " (scene units; distance of the result's vertices to the input surface)\n";
   out << "  level iter  faces  similarity  kappa  step_px(mean/max)  regulariser  seconds\n";
@@ -303,15 +303,37 @@ RefineSummary RefineMesh(const ViewSource& source, const RefineOptions& options,
   DenoiseOptions denoise = options.denoise;
   denoise.method = options.regularizer == "laplacian" ? "laplacian" : "lp";
 
-  summary.initial_similarity = FullResolutionSimilarity(source, pairs, similarity, options.pair, V,
-                                                        F, renderer, cache_bytes / 2, &images);
-  MR_LOG(INFO) << "Initial mean similarity (ZNCC, full resolution): "
-               << summary.initial_similarity;
+  // With one level the first iteration measures the same thing (plain ZNCC
+  // of all pairs at full resolution; κ does not enter m) on the input
+  // remeshed to the working resolution, so it is taken from there.
+  const bool initial_from_first_iteration =
+      options.num_levels == 1 && options.iterations_per_level > 0;
+  if (!initial_from_first_iteration) {
+    summary.initial_similarity = FullResolutionSimilarity(
+        source, pairs, similarity, options.pair, V, F, renderer, cache_bytes / 2, &images);
+    MR_LOG(INFO) << "Initial mean similarity (ZNCC, full resolution): "
+                 << summary.initial_similarity;
+  }
   const int total_iterations = options.num_levels * options.iterations_per_level;
   int global_iteration = 0;
+  bool guard_verified_clean = false;  // the last iteration's guard found no intersection
   for (int level = options.num_levels - 1; level >= 0; --level) {
     const std::vector<PinholeView> views = ScaledViews(source, level);
     RemeshForLevel(views, options, max_faces, &V, &F);
+    guard_verified_clean = false;
+    // The iterations start from a mesh without self-intersections (what the
+    // repair cannot remove is tolerated, and only new ones are undone).
+    std::vector<std::pair<int, int>> allowed_pairs;
+    if (options.prevent_self_intersections) {
+      SelfIntersectionReport start = CountSelfIntersections(V, F, true);
+      if (start.intersecting_pairs > 0) {
+        MR_LOG(INFO) << "Level " << level << " starts with " << start.intersecting_pairs
+                     << " intersecting face pairs; repairing";
+        RemoveSelfIntersections(&V, &F);
+        start = CountSelfIntersections(V, F, true);
+      }
+      allowed_pairs = std::move(start.pairs);
+    }
     RenderCache renders(renderer, views, cache_bytes / 2);
     MR_LOG(INFO) << "Level " << level << ": " << views[0].width << "x" << views[0].height
                  << " images, " << F.rows() << " faces";
@@ -333,7 +355,13 @@ RefineSummary RefineMesh(const ViewSource& source, const RefineOptions& options,
       MeshGeometry geometry{&V, &F, FaceNormals(V, F)};
       const DataTerm term = ComputeDataTerm(geometry, views, pairs, level, similarity,
                                             options.pair, &renders, &images);
+      record.data_seconds = ElapsedSeconds() - t_iter;
       record.mean_similarity = term.MeanSimilarity();
+      if (initial_from_first_iteration && global_iteration == 0) {
+        summary.initial_similarity = record.mean_similarity;
+        MR_LOG(INFO) << "Initial mean similarity (ZNCC, full resolution, input remeshed to "
+                     << F.rows() << " faces): " << summary.initial_similarity;
+      }
       if (term.valid_pixels == 0) {
         MR_THROW_INPUT << "no pixel of any view pair sees a common surface point: the mesh is "
                           "not visible in overlapping views";
@@ -359,6 +387,7 @@ RefineSummary RefineMesh(const ViewSource& source, const RefineOptions& options,
       record.mean_step_px = num_moved > 0 ? step_sum / num_moved : 0;
       record.max_step_px = step_max;
 
+      const double t_silhouette = ElapsedSeconds();
       if (use_silhouettes) {
         Eigen::MatrixXd sil = Eigen::MatrixXd::Zero(V.rows(), 3);
         Eigen::VectorXd count = Eigen::VectorXd::Zero(V.rows());
@@ -376,6 +405,8 @@ RefineSummary RefineMesh(const ViewSource& source, const RefineOptions& options,
         }
       }
 
+      const double t_denoise = ElapsedSeconds();
+      record.silhouette_seconds = t_denoise - t_silhouette;
       const Eigen::MatrixXd V_half = V + step;
       if (options.regularizer != "none") {
         const DenoiseResult denoised = Denoise(V_half, F, denoise);
@@ -384,19 +415,36 @@ RefineSummary RefineMesh(const ViewSource& source, const RefineOptions& options,
       } else {
         V = V_half;
       }
+      const double t_cleanup = ElapsedSeconds();
+      record.denoise_seconds = t_cleanup - t_denoise;
       summary.flipped_faces_fixed += FixFlippedFaces(V_before, F, &V).initial_flipped;
+      if (options.prevent_self_intersections) {
+        const UndoSelfIntersectionsSummary undone =
+            UndoSelfIntersections(V_before, F, allowed_pairs, &V);
+        summary.self_intersections_undone += undone.initial_pairs;
+        summary.vertices_reset += undone.reset_vertices;
+        if (undone.initial_pairs > 0) MR_LOG(INFO) << "UndoSelfIntersections: " << undone.BriefReport();
+      }
+      guard_verified_clean = options.prevent_self_intersections && allowed_pairs.empty();
 
+      record.cleanup_seconds = ElapsedSeconds() - t_cleanup;
       record.seconds = ElapsedSeconds() - t_iter;
       MR_LOG(INFO) << "Level " << level << " iteration " << it + 1 << "/"
                    << options.iterations_per_level << ": similarity " << record.mean_similarity
                    << ", step " << record.mean_step_px << " px (max " << record.max_step_px
-                   << "), " << record.regularizer_report << ", " << record.seconds << " s";
+                   << "), " << record.regularizer_report << "; " << record.seconds
+                   << " s (data " << record.data_seconds << ", silhouette "
+                   << record.silhouette_seconds << ", denoise " << record.denoise_seconds
+                   << ", clean-up " << record.cleanup_seconds << ")";
       summary.iterations.push_back(record);
     }
   }
 
-  // Leave no self-intersection behind (the flow can fold thin parts).
-  const SelfIntersectionReport intersections = CountSelfIntersections(V, F);
+  // Leave no self-intersection behind (the flow can fold thin parts). When
+  // the last iteration's guard already checked the mesh and found none, that
+  // check stands.
+  const SelfIntersectionReport intersections =
+      guard_verified_clean ? SelfIntersectionReport() : CountSelfIntersections(V, F);
   summary.self_intersections = static_cast<int>(intersections.intersecting_pairs);
   if (intersections.intersecting_pairs > 0) {
     const RemoveSelfIntersectionsSummary repair = RemoveSelfIntersections(&V, &F);
@@ -436,6 +484,8 @@ void RegisterRefineOptions(OptionManager* o, RefineOptions* r) {
   o->Add("Refine.regularizer", &r->regularizer, "lp (content-aware L_p), laplacian or none");
   o->Add("Refine.silhouette_weight", &r->silhouette_weight,
          "weight of the silhouette term when masks exist (>= 0)");
+  o->Add("Refine.prevent_self_intersections", &r->prevent_self_intersections,
+         "undo, every iteration, the moves that make faces intersect");
   o->Add("Refine.cache_mb", &r->cache_mb, "memory budget for cached images and renders (MB)");
   o->Add("ViewSelection.num_neighbors", &r->view_selection.num_neighbors,
          "neighbour views per view (1..16)");
@@ -462,17 +512,16 @@ double PhotoConsistency(const ViewSource& source, const std::vector<int>& eval_v
   SimilarityOptions zncc;
   zncc.method = "zncc";
   PairTermOptions pair;
-  DataTerm term;
-  term.Reset(static_cast<int>(V.rows()));
+  DataTermAccumulator accumulator(static_cast<int>(V.rows()));
   const std::set<int> evaluated(eval_views.begin(), eval_views.end());
   for (int i : eval_views) {
     for (int j : neighbors.at(i)) {
       if (evaluated.count(j)) continue;  // compare only against views that were used
-      AccumulatePairTerm(geometry, views[i], *renders.Get(i), images.Gray(i, 0), views[j],
-                         *renders.Get(j), images.Gray(j, 0), zncc, pair, &term);
+      accumulator.AddPair(geometry, views[i], *renders.Get(i), images.Gray(i, 0), views[j],
+                          *renders.Get(j), images.Gray(j, 0), zncc, pair);
     }
   }
-  return term.MeanSimilarity();
+  return accumulator.Sum().MeanSimilarity();
 }
 
 }  // namespace mr

@@ -72,6 +72,10 @@ struct RefineOptions {
   std::string regularizer = "lp";
   // Weight of the silhouette (horizon) term when masks exist (>= 0; 0 = off).
   double silhouette_weight = 1.0;
+  // Check every iteration for faces that the step made intersect and move
+  // their vertices back (UndoSelfIntersections), so that thin parts cannot
+  // fold through each other. Off: only the final repair runs.
+  bool prevent_self_intersections = true;
   // Memory budget for cached images and renders, in MB (>= 64).
   int cache_mb = 1024;
 
@@ -92,6 +96,10 @@ struct RefineIteration {
   double mean_step_px = 0;     // mean |gradient step| in pixel footprints
   double max_step_px = 0;
   std::string regularizer_report;  // e.g. "p=0.5 theta=... sigma=... lambda=..."
+  // Where the iteration's time went: renders and pair terms, the silhouette
+  // term, the proximal (denoising) step, and the clean-up (flipped faces and
+  // self-intersections undone).
+  double data_seconds = 0, silhouette_seconds = 0, denoise_seconds = 0, cleanup_seconds = 0;
   double seconds = 0;
 };
 
@@ -101,9 +109,14 @@ struct RefineSummary {
   int num_pairs = 0;
   int initial_faces = 0, final_faces = 0;
   int initial_vertices = 0, final_vertices = 0;
-  double initial_similarity = 0;  // mean ZNCC of all pairs at full resolution, before
+  // Mean ZNCC of all pairs at full resolution, before (with one pyramid
+  // level: of the input remeshed to the working resolution, as measured by
+  // the first iteration) and after refinement.
+  double initial_similarity = 0;
   double final_similarity = 0;    // and after refinement
   int flipped_faces_fixed = 0;
+  long self_intersections_undone = 0;  // new intersecting pairs undone during the iterations
+  int vertices_reset = 0;              // vertex moves undone for them
   int self_intersections = -1;    // of the result (-1: not computed)
   // Distance of the result's vertices to the (cleaned) input surface, in
   // scene units: how far the refinement moved the surface.
