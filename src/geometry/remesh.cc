@@ -430,13 +430,30 @@ RemoveSelfIntersectionsSummary RemoveSelfIntersections(
 
 namespace {
 
-// The intersecting face pairs (a < b, sorted) that involve at least one face
-// of `faces`: CGAL's test on the range made of those faces and of every face
-// whose bounding box overlaps one of theirs (box_intersection_d), so that no
-// pair with a face of `faces` is missed and the rest of the mesh is skipped.
-std::vector<std::pair<int, int>> IntersectingPairsInvolving(const Eigen::MatrixXd& V,
-                                                            const Eigen::MatrixXi& F,
-                                                            const std::vector<int>& faces) {
+// The intersecting face pairs (a < b, sorted) among the faces of `range`
+// (CGAL's test; a fresh mesh from ToCgal, so face index == row of F).
+std::vector<std::pair<int, int>> IntersectingPairs(const Mesh& mesh,
+                                                   const std::vector<Mesh::Face_index>& range) {
+  std::vector<std::pair<Mesh::Face_index, Mesh::Face_index>> found;
+  RunCgal("UndoSelfIntersections", [&] {
+    PMP::self_intersections<CGAL::Parallel_if_available_tag>(range, mesh,
+                                                             std::back_inserter(found));
+  });
+  std::vector<std::pair<int, int>> pairs;
+  pairs.reserve(found.size());
+  for (const auto& p : found) {
+    const int a = static_cast<int>(p.first.idx()), b = static_cast<int>(p.second.idx());
+    pairs.emplace_back(std::min(a, b), std::max(a, b));
+  }
+  std::sort(pairs.begin(), pairs.end());
+  return pairs;
+}
+
+// The range that holds every pair involving a face of `faces`: those faces
+// and every face whose bounding box overlaps one of theirs
+// (box_intersection_d), so the rest of the mesh is skipped.
+std::vector<Mesh::Face_index> FacesNear(const Eigen::MatrixXd& V, const Eigen::MatrixXi& F,
+                                        const std::vector<int>& faces) {
   using Box = CGAL::Box_intersection_d::Box_with_info_d<double, 3, int>;
   auto face_box = [&](int f) {
     CGAL::Bbox_3 b;
@@ -454,23 +471,11 @@ std::vector<std::pair<int, int>> IntersectingPairsInvolving(const Eigen::MatrixX
   for (int f : faces) in_range[f] = 1;
   CGAL::box_intersection_d(queries.begin(), queries.end(), all.begin(), all.end(),
                            [&](const Box&, const Box& b) { in_range[b.info()] = 1; });
-  const Mesh mesh = ToCgal(V, F, "UndoSelfIntersections");
   std::vector<Mesh::Face_index> range;
   for (int f = 0; f < F.rows(); ++f) {
     if (in_range[f]) range.push_back(Mesh::Face_index(f));
   }
-  std::vector<std::pair<Mesh::Face_index, Mesh::Face_index>> found;
-  RunCgal("UndoSelfIntersections", [&] {
-    PMP::self_intersections<CGAL::Parallel_if_available_tag>(range, mesh,
-                                                             std::back_inserter(found));
-  });
-  std::vector<std::pair<int, int>> pairs;
-  for (const auto& p : found) {
-    const int a = static_cast<int>(p.first.idx()), b = static_cast<int>(p.second.idx());
-    pairs.emplace_back(std::min(a, b), std::max(a, b));
-  }
-  std::sort(pairs.begin(), pairs.end());
-  return pairs;
+  return range;
 }
 
 }  // namespace
@@ -501,23 +506,25 @@ UndoSelfIntersectionsSummary UndoSelfIntersections(
   // mesh) check, new pairs can only involve these.
   std::vector<int> changed_faces;
   std::vector<std::vector<int>> vertex_faces;
+  Mesh mesh = ToCgal(*V_after, F, "UndoSelfIntersections");  // points updated on reset
+  const auto all_faces = faces(mesh);
   for (bool first = true;; first = false) {
-    const std::vector<std::pair<int, int>> pairs =
-        first ? CountSelfIntersections(*V_after, F, true).pairs
-              : IntersectingPairsInvolving(*V_after, F, changed_faces);
-    std::vector<int> faces;
+    const std::vector<std::pair<int, int>> pairs = IntersectingPairs(
+        mesh, first ? std::vector<Mesh::Face_index>(all_faces.begin(), all_faces.end())
+                    : FacesNear(*V_after, F, changed_faces));
+    std::vector<int> offending;  // faces of new pairs, then flipped faces
     long new_pairs = 0;
     for (const auto& p : pairs) {
       if (std::binary_search(allowed.begin(), allowed.end(), p)) continue;
       ++new_pairs;
-      faces.push_back(p.first);
-      faces.push_back(p.second);
+      offending.push_back(p.first);
+      offending.push_back(p.second);
     }
     const std::vector<int> flipped = FlippedFaces(V_before, *V_after, F);
-    faces.insert(faces.end(), flipped.begin(), flipped.end());
+    offending.insert(offending.end(), flipped.begin(), flipped.end());
     if (first) summary.initial_pairs = new_pairs;
     summary.initial_flipped += static_cast<int>(flipped.size());
-    if (faces.empty()) break;
+    if (offending.empty()) break;
     ++summary.rounds;
     if (vertex_faces.empty()) {
       vertex_faces.resize(V_after->rows());
@@ -527,12 +534,13 @@ UndoSelfIntersectionsSummary UndoSelfIntersections(
     }
     int newly_reset = 0;
     changed_faces.clear();
-    for (int f : faces) {
+    for (int f : offending) {
       for (int k = 0; k < 3; ++k) {
         const int v = F(f, k);
         if (reset[v]) continue;
         reset[v] = 1;
         V_after->row(v) = V_before.row(v);
+        mesh.point(Mesh::Vertex_index(v)) = Point(V_before(v, 0), V_before(v, 1), V_before(v, 2));
         ++newly_reset;
         changed_faces.insert(changed_faces.end(), vertex_faces[v].begin(), vertex_faces[v].end());
       }
