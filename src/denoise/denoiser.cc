@@ -203,12 +203,12 @@ bool DenoiseOptions::Check() const {
   MR_CHECK_OPTION(max_iterations >= 1, max_iterations, "max_iterations >= 1");
   MR_CHECK_OPTION(estimate_iterations >= 1, estimate_iterations, "estimate_iterations >= 1");
   MR_CHECK_OPTION(tolerance >= 0, tolerance, "tolerance >= 0");
-  MR_CHECK_OPTION(p_min > 0 && p_min <= 1, p_min, "0 < p_min <= 1");
-  MR_CHECK_OPTION(p_max >= p_min && p_max <= 1, p_max, "p_min <= p_max <= 1");
+  MR_CHECK_OPTION(p_min > 0 && p_min <= 2, p_min, "0 < p_min <= 2");
+  MR_CHECK_OPTION(p_max >= p_min && p_max <= 2, p_max, "p_min <= p_max <= 2");
   MR_CHECK_OPTION(p_step > 0, p_step, "p_step > 0");
   MR_CHECK_OPTION(lambda_scale > 0, lambda_scale, "lambda_scale > 0");
   MR_CHECK_OPTION(fixed_lambda >= 0, fixed_lambda, "fixed_lambda >= 0");
-  MR_CHECK_OPTION(fixed_p >= 0 && fixed_p <= 1, fixed_p, "0 <= fixed_p <= 1");
+  MR_CHECK_OPTION(fixed_p >= 0 && fixed_p <= 2, fixed_p, "0 <= fixed_p <= 2");
   MR_CHECK_OPTION(beta_initial > 0, beta_initial, "beta_initial > 0");
   MR_CHECK_OPTION(beta_max >= beta_initial, beta_max, "beta_max >= beta_initial");
   MR_CHECK_OPTION(beta_factor > 1, beta_factor, "beta_factor > 1");
@@ -304,13 +304,13 @@ void RegisterDenoiseOptions(OptionManager* m, DenoiseOptions* o, const std::stri
   m->Add(name("max_iterations"), &o->max_iterations,
          "lp: outer iterations (parameter estimation + solve), >= 1");
   m->Add(name("tolerance"), &o->tolerance, "lp: stop when RMS change < this (mean edges), >= 0");
-  m->Add(name("p_min"), &o->p_min, "lp: smallest p of the search grid, (0, 1]");
-  m->Add(name("p_max"), &o->p_max, "lp: largest p of the search grid, [p_min, 1]");
+  m->Add(name("p_min"), &o->p_min, "lp: smallest p of the search grid, (0, 2]");
+  m->Add(name("p_max"), &o->p_max, "lp: largest p of the search grid, [p_min, 2]");
   m->Add(name("p_step"), &o->p_step, "lp: step of the p grid, > 0");
   m->Add(name("lambda_scale"), &o->lambda_scale, "lp: multiplies the estimated lambda, > 0");
   m->Add(name("fixed_lambda"), &o->fixed_lambda,
          "lp: if > 0, lambda in scene units^(2-p) instead of the estimate");
-  m->Add(name("fixed_p"), &o->fixed_p, "lp: if in (0, 1], p instead of the search; 0 = search");
+  m->Add(name("fixed_p"), &o->fixed_p, "lp: if in (0, 2], p instead of the search; 0 = search");
   m->Add(name("beta_initial"), &o->beta_initial, "lp: first penalty (mean edge = 1 units), > 0");
   m->Add(name("beta_max"), &o->beta_max, "lp: last penalty, >= beta_initial");
   m->Add(name("beta_factor"), &o->beta_factor, "lp: penalty growth per step, > 1");

@@ -51,7 +51,10 @@ struct DenoiseOptions {
   // Stop the outer loop when the relative change of X (RMS, in mean edge
   // lengths) falls below this, >= 0.
   double tolerance = 1e-3;
-  // Grid for the 1-D search of p: p_min, p_min + p_step, ..., p_max; in (0, 1].
+  // Grid for the 1-D search of p: p_min, p_min + p_step, ..., p_max; in (0, 2]
+  // (p > 1 is the convex range; the default grid stops at 1: extending it made
+  // round 1 pick p = 1.65-1.9 on the noisy inputs and was worse everywhere,
+  // docs/denoising.md).
   double p_min = 0.1;
   double p_max = 1.0;
   double p_step = 0.05;
@@ -61,7 +64,7 @@ struct DenoiseOptions {
   // If > 0, fixes lambda (in the caller's units of length^(2-p)) instead of
   // estimating it; for experiments.
   double fixed_lambda = 0.0;
-  // If in (0, 1], fixes p instead of searching it; 0 = search.
+  // If in (0, 2], fixes p instead of searching it; 0 = search.
   double fixed_p = 0.0;
   // Penalty continuation for the splitting, in units where the mean edge
   // length is 1: beta goes beta_initial, * beta_factor, ... up to beta_max.

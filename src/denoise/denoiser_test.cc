@@ -66,6 +66,14 @@ TEST(DenoiseOptions, BadValuesThrow) {
   o.p_min = 0;
   EXPECT_THROW(o.Check(), InputError);
   o = DenoiseOptions();
+  o.p_max = 2.0;  // the convex range p in (1, 2] is allowed
+  EXPECT_TRUE(o.Check());
+  o.p_max = 2.5;
+  EXPECT_THROW(o.Check(), InputError);
+  o = DenoiseOptions();
+  o.fixed_p = 2.5;
+  EXPECT_THROW(o.Check(), InputError);
+  o = DenoiseOptions();
   o.method = "l0";
   EXPECT_TRUE(o.Check());
   o.l0_beta_factor = 1.0;
