@@ -3,7 +3,6 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
-#include <cstdlib>
 #include <sstream>
 
 #include "denoise/baselines.h"
@@ -112,20 +111,9 @@ void DenoiseLp(const Eigen::MatrixXd& V0, const Eigen::MatrixXi& F, const Denois
     } else if (o.fixed_p > 0) {
       p = o.fixed_p;
       theta = ThetaClosedForm(row_norms, p);
-    } else if (k == 0 && std::getenv("XR1P")) {
-      p = std::atof(std::getenv("XR1P"));
-      theta = ThetaClosedForm(row_norms, p);
-    } else if (k > 0 && std::getenv("XR2P")) {
-      p = std::atof(std::getenv("XR2P"));
-      theta = ThetaClosedForm(row_norms, p);
     } else {
       p = EstimateP(row_norms, o.p_min, o.p_max, o.p_step, &theta);
     }
-    if (k == 0 && std::getenv("XR1LS")) sigma2 *= std::atof(std::getenv("XR1LS"));
-    if (k > 0 && std::getenv("XR2LS")) sigma2 *= std::atof(std::getenv("XR2LS"));
-    if (std::getenv("XP")) p = std::atof(std::getenv("XP"));
-    if (std::getenv("XTHETA")) theta = std::atof(std::getenv("XTHETA"));
-    if (std::getenv("XSIG")) sigma2 = std::pow(std::atof(std::getenv("XSIG")), 2);
     double lambda = o.fixed_lambda > 0 ? o.fixed_lambda / std::pow(h, 2.0 - p)
                                        : 0.5 * theta * sigma2 * o.lambda_scale;
     if (!std::isfinite(lambda)) lambda = 0;
