@@ -61,6 +61,14 @@ struct DenoiseOptions {
   // Multiplies the estimated lambda = theta sigma^2 / 2 (the refiner's
   // proximal step passes its step size eta here), > 0.
   double lambda_scale = 1.0;
+  // Row weights of the prior: it acts on s_e |(D X)_e| with s_e = l_e^a, l_e
+  // the length of row e's edge in the current X in mean edge lengths (so
+  // scale-free), a = edge_length_exponent, recomputed with D's weights. a = 1
+  // weighs each row by its edge's length (the measure of a dihedral angle's
+  // edge: s_e |(D X)_e| ~ angle x area for a fold); 0 = the unweighted prior
+  // (the default before; 0.1-0.4 deg worse on every benchmark model,
+  // docs/denoising.md). In [0, 4].
+  double edge_length_exponent = 1.0;
   // If > 0, fixes lambda (in the caller's units of length^(2-p)) instead of
   // estimating it; for experiments.
   double fixed_lambda = 0.0;
