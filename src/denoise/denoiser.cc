@@ -83,15 +83,26 @@ void DenoiseLp(const Eigen::MatrixXd& V0, const Eigen::MatrixXi& F, const Denois
   result->setup_seconds = Now() - t0;
 
   const double sigma0 = RobustSigma(ApplyEdgeOperator(eq.quads, W, X0), W);
+  Eigen::VectorXd row_scale = Eigen::VectorXd::Ones(eq.quads.rows());
   for (int k = 0; k < o.max_iterations; ++k) {
     const double tk = Now();
     DenoiseIteration it;
     if (k > 0 && o.update_operator) W = EdgeWeights(X, eq.quads, &degenerate);
+    // Row weights s_e = l_e^a (l_e the edge's length in the current X, unit mean
+    // edge): the prior acts on s_e |(D X)_e| (docs/denoising.md, "Row weights").
+    if (k == 0 || o.update_operator) {
+      for (int i = 0; i < eq.quads.rows(); ++i) {
+        row_scale(i) = o.edge_length_exponent == 0
+                           ? 1.0
+                           : std::pow((X.row(eq.quads(i, 1)) - X.row(eq.quads(i, 0))).norm(),
+                                      o.edge_length_exponent);
+      }
+    }
     const Eigen::MatrixXd R = ApplyEdgeOperator(eq.quads, W, X);
     std::vector<double> norms;
     norms.reserve(R.rows());
     for (int i = 0; i < R.rows(); ++i) {
-      if (W.row(i).squaredNorm() > 0) norms.push_back(R.row(i).norm());
+      if (W.row(i).squaredNorm() > 0) norms.push_back(row_scale(i) * R.row(i).norm());
     }
     const Eigen::VectorXd row_norms =
         Eigen::Map<Eigen::VectorXd>(norms.data(), static_cast<int>(norms.size()));
@@ -140,15 +151,21 @@ void DenoiseLp(const Eigen::MatrixXd& V0, const Eigen::MatrixXi& F, const Denois
     } else {
       betas.assign(o.warm_iterations, o.beta_max);
     }
+    // s_e^p, the factor of the shrinkage parameter of row e in this round.
+    Eigen::VectorXd shrink_scale = row_scale;
+    if (o.edge_length_exponent != 0) {
+      for (int i = 0; i < shrink_scale.size(); ++i) shrink_scale(i) = std::pow(row_scale(i), p);
+    }
     Eigen::MatrixXd Xk = X;
     double factored_beta = -1;
     for (double beta : betas) {
-      // psi-step: per-row vector GST with threshold lambda / (2 beta).
+      // psi-step: per-row vector GST of min beta |psi - D X|^2 + lambda
+      // (s_e |psi|)^p, i.e. with parameter lambda s_e^p / (2 beta).
       Eigen::MatrixXd Psi = ApplyEdgeOperator(eq.quads, W, Xk);
       const double tau = lambda / (2.0 * beta);
 #pragma omp parallel for schedule(static) if (Psi.rows() > 50000)
       for (int i = 0; i < Psi.rows(); ++i) {
-        Psi.row(i) = GstShrinkVector(Psi.row(i).transpose(), tau, p).transpose();
+        Psi.row(i) = GstShrinkVector(Psi.row(i).transpose(), tau * shrink_scale(i), p).transpose();
       }
       // X-step: (I + 2 beta D^T D) X = X0 + 2 beta D^T psi.
       const Eigen::MatrixXd rhs = X0 + 2.0 * beta * ApplyEdgeOperatorTranspose(eq.quads, W, Psi, n);
@@ -203,12 +220,14 @@ bool DenoiseOptions::Check() const {
   MR_CHECK_OPTION(max_iterations >= 1, max_iterations, "max_iterations >= 1");
   MR_CHECK_OPTION(estimate_iterations >= 1, estimate_iterations, "estimate_iterations >= 1");
   MR_CHECK_OPTION(tolerance >= 0, tolerance, "tolerance >= 0");
-  MR_CHECK_OPTION(p_min > 0 && p_min <= 1, p_min, "0 < p_min <= 1");
-  MR_CHECK_OPTION(p_max >= p_min && p_max <= 1, p_max, "p_min <= p_max <= 1");
+  MR_CHECK_OPTION(p_min > 0 && p_min <= 2, p_min, "0 < p_min <= 2");
+  MR_CHECK_OPTION(p_max >= p_min && p_max <= 2, p_max, "p_min <= p_max <= 2");
   MR_CHECK_OPTION(p_step > 0, p_step, "p_step > 0");
   MR_CHECK_OPTION(lambda_scale > 0, lambda_scale, "lambda_scale > 0");
   MR_CHECK_OPTION(fixed_lambda >= 0, fixed_lambda, "fixed_lambda >= 0");
-  MR_CHECK_OPTION(fixed_p >= 0 && fixed_p <= 1, fixed_p, "0 <= fixed_p <= 1");
+  MR_CHECK_OPTION(fixed_p >= 0 && fixed_p <= 2, fixed_p, "0 <= fixed_p <= 2");
+  MR_CHECK_OPTION(edge_length_exponent >= 0 && edge_length_exponent <= 4, edge_length_exponent,
+                  "0 <= edge_length_exponent <= 4");
   MR_CHECK_OPTION(beta_initial > 0, beta_initial, "beta_initial > 0");
   MR_CHECK_OPTION(beta_max >= beta_initial, beta_max, "beta_max >= beta_initial");
   MR_CHECK_OPTION(beta_factor > 1, beta_factor, "beta_factor > 1");
@@ -304,13 +323,16 @@ void RegisterDenoiseOptions(OptionManager* m, DenoiseOptions* o, const std::stri
   m->Add(name("max_iterations"), &o->max_iterations,
          "lp: outer iterations (parameter estimation + solve), >= 1");
   m->Add(name("tolerance"), &o->tolerance, "lp: stop when RMS change < this (mean edges), >= 0");
-  m->Add(name("p_min"), &o->p_min, "lp: smallest p of the search grid, (0, 1]");
-  m->Add(name("p_max"), &o->p_max, "lp: largest p of the search grid, [p_min, 1]");
+  m->Add(name("p_min"), &o->p_min, "lp: smallest p of the search grid, (0, 2]");
+  m->Add(name("p_max"), &o->p_max, "lp: largest p of the search grid, [p_min, 2]");
   m->Add(name("p_step"), &o->p_step, "lp: step of the p grid, > 0");
   m->Add(name("lambda_scale"), &o->lambda_scale, "lp: multiplies the estimated lambda, > 0");
   m->Add(name("fixed_lambda"), &o->fixed_lambda,
          "lp: if > 0, lambda in scene units^(2-p) instead of the estimate");
-  m->Add(name("fixed_p"), &o->fixed_p, "lp: if in (0, 1], p instead of the search; 0 = search");
+  m->Add(name("fixed_p"), &o->fixed_p, "lp: if in (0, 2], p instead of the search; 0 = search");
+  m->Add(name("edge_length_exponent"), &o->edge_length_exponent,
+         "lp: prior on l_e^a |(D X)_e|, l_e the edge length in mean edges; 0 = unweighted, "
+         "[0, 4]");
   m->Add(name("beta_initial"), &o->beta_initial, "lp: first penalty (mean edge = 1 units), > 0");
   m->Add(name("beta_max"), &o->beta_max, "lp: last penalty, >= beta_initial");
   m->Add(name("beta_factor"), &o->beta_factor, "lp: penalty growth per step, > 1");

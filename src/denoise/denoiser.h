@@ -51,17 +51,28 @@ struct DenoiseOptions {
   // Stop the outer loop when the relative change of X (RMS, in mean edge
   // lengths) falls below this, >= 0.
   double tolerance = 1e-3;
-  // Grid for the 1-D search of p: p_min, p_min + p_step, ..., p_max; in (0, 1].
+  // Grid for the 1-D search of p: p_min, p_min + p_step, ..., p_max; in (0, 2]
+  // (p > 1 is the convex range; the default grid stops at 1: extending it made
+  // round 1 pick p = 1.65-1.9 on the noisy inputs and was worse everywhere,
+  // docs/denoising.md).
   double p_min = 0.1;
   double p_max = 1.0;
   double p_step = 0.05;
   // Multiplies the estimated lambda = theta sigma^2 / 2 (the refiner's
   // proximal step passes its step size eta here), > 0.
   double lambda_scale = 1.0;
+  // Row weights of the prior: it acts on s_e |(D X)_e| with s_e = l_e^a, l_e
+  // the length of row e's edge in the current X in mean edge lengths (so
+  // scale-free), a = edge_length_exponent, recomputed with D's weights. a = 1
+  // weighs each row by its edge's length (the measure of a dihedral angle's
+  // edge: s_e |(D X)_e| ~ angle x area for a fold); 0 = the unweighted prior
+  // (the default before; 0.1-0.4 deg worse on every benchmark model,
+  // docs/denoising.md). In [0, 4].
+  double edge_length_exponent = 1.0;
   // If > 0, fixes lambda (in the caller's units of length^(2-p)) instead of
   // estimating it; for experiments.
   double fixed_lambda = 0.0;
-  // If in (0, 1], fixes p instead of searching it; 0 = search.
+  // If in (0, 2], fixes p instead of searching it; 0 = search.
   double fixed_p = 0.0;
   // Penalty continuation for the splitting, in units where the mean edge
   // length is 1: beta goes beta_initial, * beta_factor, ... up to beta_max.

@@ -66,6 +66,14 @@ TEST(DenoiseOptions, BadValuesThrow) {
   o.p_min = 0;
   EXPECT_THROW(o.Check(), InputError);
   o = DenoiseOptions();
+  o.p_max = 2.0;  // the convex range p in (1, 2] is allowed
+  EXPECT_TRUE(o.Check());
+  o.p_max = 2.5;
+  EXPECT_THROW(o.Check(), InputError);
+  o = DenoiseOptions();
+  o.fixed_p = 2.5;
+  EXPECT_THROW(o.Check(), InputError);
+  o = DenoiseOptions();
   o.method = "l0";
   EXPECT_TRUE(o.Check());
   o.l0_beta_factor = 1.0;
@@ -166,6 +174,26 @@ TEST(Denoise, LpRecoversNoisyCube) {
     EXPECT_LE(it.p, 1);
     EXPECT_GT(it.lambda, 0);
   }
+}
+
+// The prior's row weights l_e^a (edge_length_exponent): a = 0 is the
+// unweighted prior; both recover the noisy cube and the option changes the
+// result (it is wired into the fit and the shrinkage).
+TEST(Denoise, EdgeLengthExponent) {
+  Eigen::MatrixXd clean, noisy;
+  Eigen::MatrixXi F;
+  NoisyCube(&clean, &noisy, &F);
+  DenoiseOptions unweighted;
+  unweighted.edge_length_exponent = 0;
+  const DenoiseResult a = Denoise(noisy, F, DenoiseOptions()), b = Denoise(noisy, F, unweighted);
+  EXPECT_LT(MeanAngleDeg(a.V, clean, F), 3.0);
+  EXPECT_LT(MeanAngleDeg(b.V, clean, F), 3.0);
+  EXPECT_GT((a.V - b.V).norm(), 0);
+  DenoiseOptions bad;
+  bad.edge_length_exponent = -1;
+  EXPECT_THROW(bad.Check(), InputError);
+  bad.edge_length_exponent = 5;
+  EXPECT_THROW(bad.Check(), InputError);
 }
 
 // The conjugate-gradient X-step (default) solves the same problem as the

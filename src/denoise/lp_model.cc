@@ -126,7 +126,8 @@ Eigen::MatrixXd ApplyEdgeOperator(const Eigen::MatrixXi& quads, const Eigen::Mat
 
 double GstThreshold(double lambda, double p) {
   if (lambda <= 0) return 0;
-  if (p >= 1.0) return lambda;
+  if (p > 1.0) return 0;  // convex: only y = 0 maps to 0
+  if (p == 1.0) return lambda;
   const double a = 2.0 * lambda * (1.0 - p);
   return std::pow(a, 1.0 / (2.0 - p)) + lambda * p * std::pow(a, (p - 1.0) / (2.0 - p));
 }
@@ -134,7 +135,27 @@ double GstThreshold(double lambda, double p) {
 double GstShrink(double y, double lambda, double p) {
   const double ay = std::abs(y);
   if (lambda <= 0) return y;
-  if (p >= 1.0) return ay <= lambda ? 0.0 : std::copysign(ay - lambda, y);
+  if (p == 1.0) return ay <= lambda ? 0.0 : std::copysign(ay - lambda, y);
+  if (p > 1.0) {
+    // Convex case: the minimiser x in (0, |y|) solves g(x) = x + lambda p
+    // x^(p-1) - |y| = 0 (g increasing, no threshold). Safeguarded Newton on
+    // the bracket [lo, hi].
+    if (p >= 2.0) return y / (1.0 + 2.0 * lambda);
+    double lo = 0, hi = ay, x = ay / (1.0 + lambda * p * std::pow(ay, p - 2.0));
+    for (int it = 0; it < 100; ++it) {
+      const double g = x + lambda * p * std::pow(x, p - 1.0) - ay;
+      if (g > 0) hi = x; else lo = x;
+      const double dg = 1.0 + lambda * p * (p - 1.0) * std::pow(x, p - 2.0);
+      double next = x - g / dg;
+      if (!(next > lo && next < hi)) next = 0.5 * (lo + hi);
+      if (std::abs(next - x) <= 1e-13 * ay || hi - lo <= 1e-13 * ay) {
+        x = next;
+        break;
+      }
+      x = next;
+    }
+    return std::copysign(x, y);
+  }
   if (ay <= GstThreshold(lambda, p)) return 0.0;
   // Fixed point x = |y| - lambda p x^(p-1) from x = |y| (Zuo et al., Alg. 1).
   // It converges monotonically above the threshold; iterate to convergence.

@@ -43,9 +43,10 @@ Eigen::MatrixXd ApplyEdgeOperator(const Eigen::MatrixXi& quads,
                                   const Eigen::MatrixXd& X);
 
 // GST (Zuo et al. ICCV 2013): argmin_x 0.5 (x - y)^2 + lambda |x|^p for
-// p in (0, 1], lambda >= 0.
+// p in (0, 1], lambda >= 0. Also p in (1, 2] (convex, no threshold: the root
+// of x + lambda p x^(p-1) = |y| by safeguarded Newton; p = 2 is y / (1 + 2 lambda)).
 double GstShrink(double y, double lambda, double p);
-// The GST threshold: the result is 0 iff |y| <= GstThreshold(lambda, p).
+// The GST threshold: the result is 0 iff |y| <= GstThreshold(lambda, p) (0 for p > 1).
 double GstThreshold(double lambda, double p);
 // Vector GST: argmin_x 0.5 |x - y|^2 + lambda |x|_2^p (x, y in R^3). The
 // minimiser is parallel to y, so this is rotation invariant.

@@ -16,7 +16,7 @@ double GstObjective(double x, double y, double lambda, double p) {
 }
 
 TEST(Gst, MatchesBruteForce) {
-  for (double p : {0.1, 0.3, 0.5, 0.8, 1.0}) {
+  for (double p : {0.1, 0.3, 0.5, 0.8, 1.0, 1.2, 1.5, 1.9, 2.0}) {
     for (double lambda : {0.05, 0.4, 1.5}) {
       for (double y = -4.0; y <= 4.0; y += 0.173) {
         const double x = GstShrink(y, lambda, p);
@@ -37,11 +37,39 @@ TEST(Gst, MatchesBruteForce) {
   }
 }
 
+TEST(Gst, ConvexRangeHasNoThreshold) {
+  // For p in (1, 2] the problem is strictly convex: only y = 0 maps to 0, the
+  // map is odd and monotone, and p = 2 is the linear shrink y / (1 + 2 lambda).
+  for (double p : {1.01, 1.3, 1.7, 2.0}) {
+    EXPECT_EQ(GstThreshold(0.7, p), 0.0);
+    EXPECT_EQ(GstShrink(0.0, 0.7, p), 0.0);
+    double prev = 0;
+    for (double y = 1e-6; y < 10; y *= 1.7) {
+      const double x = GstShrink(y, 0.7, p);
+      EXPECT_GT(x, 0) << "p=" << p << " y=" << y;
+      EXPECT_LT(x, y);
+      EXPECT_GE(x, prev);
+      EXPECT_NEAR(GstShrink(-y, 0.7, p), -x, 1e-15);
+      // Against a 400-step bisection of x + lambda p x^(p-1) = y on [0, y]: the
+      // same to 1e-12 |y| (absolute: for p near 1 and small y the root can be
+      // below the double range, e.g. 1e-590 at p = 1.01, y = 1e-6).
+      double lo = 0, hi = y;
+      for (int i = 0; i < 400; ++i) {
+        const double mid = 0.5 * (lo + hi);
+        (mid + 0.7 * p * std::pow(mid, p - 1.0) > y ? hi : lo) = mid;
+      }
+      EXPECT_NEAR(x, 0.5 * (lo + hi), 1e-12 * y) << "p=" << p << " y=" << y;
+      prev = x;
+    }
+  }
+  EXPECT_NEAR(GstShrink(3.0, 0.25, 2.0), 2.0, 1e-15);
+}
+
 TEST(Gst, VectorIsRotationInvariant) {
   const Eigen::Vector3d y(0.3, -1.2, 0.7);
   const Eigen::Matrix3d R =
       Eigen::AngleAxisd(0.7, Eigen::Vector3d(1, 2, 3).normalized()).toRotationMatrix();
-  for (double p : {0.3, 1.0}) {
+  for (double p : {0.3, 1.0, 1.5}) {
     const Eigen::Vector3d a = R * GstShrinkVector(y, 0.5, p);
     const Eigen::Vector3d b = GstShrinkVector(R * y, 0.5, p);
     EXPECT_LT((a - b).norm(), 1e-12);
