@@ -10,6 +10,7 @@
 #include "refine/photometric.h"
 #include "refine/refiner.h"
 #include "refine/test_scene.h"
+#include "refine/view_selection.h"
 #include "render/renderer.h"
 #include "util/error.h"
 
@@ -42,6 +43,14 @@ EvaluationResult Evaluate(const Eigen::MatrixXd& V, const Eigen::MatrixXi& F,
   return EvaluateMesh(V, F, gV, gF, options);
 }
 
+// The ground truth given as input stays close to what it was, with the
+// defaults: compared with the input after the refiner's remeshing alone, the
+// flow and the proximal steps may add at most a quarter of a pixel footprint
+// to accuracy90 and one degree to the normal error. Not "no worse": the data
+// term's optimum is not exactly the ground truth (bilinear warps, windows at
+// occlusions), and the flow moves it by a fifth of a pixel (measured here:
+// accuracy90 6e-5 -> 0.0027 with footprint 0.015, normals 0.17 -> 0.88 deg;
+// without the proximal step 0.0035 and 3.2 deg).
 TEST_F(RefinerTest, GroundTruthStaysGroundTruth) {
   Eigen::MatrixXd V;
   Eigen::MatrixXi F;
@@ -50,11 +59,22 @@ TEST_F(RefinerTest, GroundTruthStaysGroundTruth) {
   TriangleMesh mesh;
   mesh.V = V;
   mesh.F = F;
-  const RefineSummary summary = RefineMesh(source, FastOptions(), &mesh, renderer_);
+  RefineOptions options;  // defaults
+  options.iterations_per_level = 6;
+  RefineOptions remesh_only = options;
+  remesh_only.iterations_per_level = 0;
+  TriangleMesh remeshed = mesh;
+  RefineMesh(source, remesh_only, &remeshed, renderer_);
+  const EvaluationResult input = Evaluate(remeshed.V, remeshed.F, V, F);
+
+  const RefineSummary summary = RefineMesh(source, options, &mesh, renderer_);
   const EvaluationResult after = Evaluate(mesh.V, mesh.F, V, F);
-  // Remeshing a curved surface costs a little accuracy (chords); the flow
-  // must not add more than a fraction of a pixel footprint (~0.018 here).
-  EXPECT_LT(after.accuracy90, 0.006) << summary.FullReport();
+  const double footprint = MedianFootprint(source.Views(), V, VertexNormals(V, F));
+  ASSERT_GT(footprint, 0);
+  EXPECT_LT(after.accuracy90, input.accuracy90 + 0.25 * footprint)
+      << "remeshed input " << input.accuracy90 << ", footprint " << footprint << "\n"
+      << summary.FullReport();
+  EXPECT_LT(after.normal_deg, input.normal_deg + 1.0) << summary.FullReport();
   EXPECT_GT(summary.final_similarity, 0.8) << summary.FullReport();
 }
 
