@@ -58,15 +58,24 @@ void HeightField(Eigen::MatrixXd* V, Eigen::MatrixXi* F) {
   }
 }
 
-TEST(PairTerm, VertexGradientMatchesFiniteDifferences) {
+// The height field seen by two cameras from above, with a smooth image each.
+struct TwoViewScene {
   Eigen::MatrixXd V;
   Eigen::MatrixXi F;
-  HeightField(&V, &F);
-  const PinholeView a = LookAtView(Eigen::Vector3d(-0.3, 0, 4), Eigen::Vector3d::Zero(),
-                                   Eigen::Vector3d(0, 1, 0), 40, 32, 40);
-  const PinholeView b = LookAtView(Eigen::Vector3d(0.4, 0.2, 4), Eigen::Vector3d::Zero(),
-                                   Eigen::Vector3d(0, 1, 0), 40, 32, 40);
-  const cv::Mat image_a = SmoothImage(40, 32, 0.0), image_b = SmoothImage(40, 32, 0.7);
+  PinholeView a = LookAtView(Eigen::Vector3d(-0.3, 0, 4), Eigen::Vector3d::Zero(),
+                             Eigen::Vector3d(0, 1, 0), 40, 32, 40);
+  PinholeView b = LookAtView(Eigen::Vector3d(0.4, 0.2, 4), Eigen::Vector3d::Zero(),
+                             Eigen::Vector3d(0, 1, 0), 40, 32, 40);
+  cv::Mat image_a = SmoothImage(40, 32, 0.0), image_b = SmoothImage(40, 32, 0.7);
+  TwoViewScene() { HeightField(&V, &F); }
+};
+
+TEST(PairTerm, VertexGradientMatchesFiniteDifferences) {
+  TwoViewScene scene;
+  Eigen::MatrixXd& V = scene.V;
+  const Eigen::MatrixXi& F = scene.F;
+  const PinholeView &a = scene.a, &b = scene.b;
+  const cv::Mat &image_a = scene.image_a, &image_b = scene.image_b;
   for (const std::string method : {"zncc", "dcv"}) {
     SimilarityOptions similarity;
     similarity.method = method;
@@ -101,14 +110,11 @@ TEST(PairTerm, VertexGradientMatchesFiniteDifferences) {
 // The accumulator's sum over two pairs equals the two pair terms added one by
 // one (the per-thread buffers are reused, not reset, between pairs).
 TEST(PairTerm, AccumulatorEqualsSumOfPairTerms) {
-  Eigen::MatrixXd V;
-  Eigen::MatrixXi F;
-  HeightField(&V, &F);
-  const PinholeView a = LookAtView(Eigen::Vector3d(-0.3, 0, 4), Eigen::Vector3d::Zero(),
-                                   Eigen::Vector3d(0, 1, 0), 40, 32, 40);
-  const PinholeView b = LookAtView(Eigen::Vector3d(0.4, 0.2, 4), Eigen::Vector3d::Zero(),
-                                   Eigen::Vector3d(0, 1, 0), 40, 32, 40);
-  const cv::Mat image_a = SmoothImage(40, 32, 0.0), image_b = SmoothImage(40, 32, 0.7);
+  TwoViewScene scene;
+  Eigen::MatrixXd& V = scene.V;
+  const Eigen::MatrixXi& F = scene.F;
+  const PinholeView &a = scene.a, &b = scene.b;
+  const cv::Mat &image_a = scene.image_a, &image_b = scene.image_b;
   SimilarityOptions similarity;
   DataTerm summed;
   PairCost(V, F, a, b, image_a, image_b, similarity, &summed);
