@@ -33,6 +33,7 @@
 #include "geometry/mesh.h"
 #include "util/error.h"
 #include "util/logging.h"
+#include "util/program.h"
 
 namespace {
 
@@ -273,8 +274,10 @@ int Speed(long faces, const std::string& linear_solver, const std::string& metho
 
 }  // namespace
 
+// Through RunProgram, like mesh_denoiser, so that the allocator settings are
+// those the programs run with (util/program.h).
 int main(int argc, char** argv) {
-  try {
+  return mr::RunProgram([&]() -> int {
     const std::string mode = argc > 1 ? argv[1] : "quality";
     if (std::getenv("MR_VERBOSE") != nullptr) mr::SetLogLevel(mr::LogLevel::kVerbose);
     if (mode == "quality") return Quality(argc > 2 ? argv[2] : MR_SHARED_DIR "/data/models", "", "");
@@ -288,8 +291,5 @@ int main(int argc, char** argv) {
                  "usage: denoise_benchmark quality [MODELS_DIR] | speed NUM_FACES [cg|cholesky] "
                  "[lp|l0] | one MODEL [METHOD]\n");
     return 1;
-  } catch (const std::exception& e) {
-    std::fprintf(stderr, "ERROR: %s\n", e.what());
-    return 1;
-  }
+  });
 }
