@@ -423,7 +423,9 @@ RefineSummary RefineMesh(const ViewSource& source, const RefineOptions& options,
             UndoSelfIntersections(V_before, F, allowed_pairs, &V);
         summary.self_intersections_undone += undone.initial_pairs;
         summary.vertices_reset += undone.reset_vertices;
-        if (undone.initial_pairs > 0) MR_LOG(INFO) << "UndoSelfIntersections: " << undone.BriefReport();
+        if (undone.initial_pairs > 0) {
+          MR_LOG(INFO) << "UndoSelfIntersections: " << undone.BriefReport();
+        }
       }
       guard_verified_clean = options.prevent_self_intersections && allowed_pairs.empty();
 
