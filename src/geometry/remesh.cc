@@ -488,9 +488,11 @@ std::string UndoSelfIntersectionsSummary::BriefReport() const {
   return s.str();
 }
 
-UndoSelfIntersectionsSummary UndoSelfIntersections(
-    const Eigen::MatrixXd& V_before, const Eigen::MatrixXi& F,
-    const std::vector<std::pair<int, int>>& allowed, Eigen::MatrixXd* V_after) {
+namespace {
+
+void CheckUndoInput(const Eigen::MatrixXd& V_before, const Eigen::MatrixXi& F,
+                    const std::vector<std::pair<int, int>>& allowed,
+                    const Eigen::MatrixXd* V_after) {
   MR_CHECK(V_after != nullptr);
   CheckMeshInput(V_before, F, "UndoSelfIntersections");
   CheckMeshInput(*V_after, F, "UndoSelfIntersections");
@@ -499,6 +501,19 @@ UndoSelfIntersectionsSummary UndoSelfIntersections(
                    << " vertices, V_after " << V_after->rows();
   }
   MR_CHECK(std::is_sorted(allowed.begin(), allowed.end()));
+}
+
+// The loop of UndoSelfIntersections on `mesh`, a CGAL mesh of F (face index
+// == row of F) whose points are overwritten with *V_after first.
+UndoSelfIntersectionsSummary UndoOnMesh(const Eigen::MatrixXd& V_before, const Eigen::MatrixXi& F,
+                                        const std::vector<std::pair<int, int>>& allowed,
+                                        Mesh* mesh_ptr, Eigen::MatrixXd* V_after) {
+  Mesh& mesh = *mesh_ptr;
+  MR_CHECK_EQ(static_cast<long>(mesh.number_of_vertices()), static_cast<long>(V_after->rows()));
+  MR_CHECK_EQ(static_cast<long>(mesh.number_of_faces()), static_cast<long>(F.rows()));
+  for (int v = 0; v < V_after->rows(); ++v) {
+    mesh.point(Mesh::Vertex_index(v)) = Point((*V_after)(v, 0), (*V_after)(v, 1), (*V_after)(v, 2));
+  }
   const double t0 = ElapsedSeconds();
   UndoSelfIntersectionsSummary summary;
   std::vector<char> reset(V_after->rows(), 0);
@@ -506,7 +521,6 @@ UndoSelfIntersectionsSummary UndoSelfIntersections(
   // mesh) check, new pairs can only involve these.
   std::vector<int> changed_faces;
   std::vector<std::vector<int>> vertex_faces;
-  Mesh mesh = ToCgal(*V_after, F, "UndoSelfIntersections");  // points updated on reset
   const auto all_faces = faces(mesh);
   for (bool first = true;; first = false) {
     const std::vector<std::pair<int, int>> pairs = IntersectingPairs(
@@ -560,6 +574,44 @@ UndoSelfIntersectionsSummary UndoSelfIntersections(
   summary.seconds = ElapsedSeconds() - t0;
   MR_LOG(VERBOSE) << "UndoSelfIntersections: " << summary.BriefReport();
   return summary;
+}
+
+}  // namespace
+
+UndoSelfIntersectionsSummary UndoSelfIntersections(
+    const Eigen::MatrixXd& V_before, const Eigen::MatrixXi& F,
+    const std::vector<std::pair<int, int>>& allowed, Eigen::MatrixXd* V_after) {
+  CheckUndoInput(V_before, F, allowed, V_after);
+  Mesh mesh = ToCgal(*V_after, F, "UndoSelfIntersections");
+  return UndoOnMesh(V_before, F, allowed, &mesh, V_after);
+}
+
+struct SelfIntersectionGuard::Impl {
+  Eigen::MatrixXi F;
+  Mesh mesh;  // F's connectivity, built once; points overwritten by every Undo
+  std::vector<std::pair<int, int>> allowed;
+};
+
+SelfIntersectionGuard::SelfIntersectionGuard(const Eigen::MatrixXd& V, const Eigen::MatrixXi& F)
+    : impl_(new Impl) {
+  CheckMeshInput(V, F, "SelfIntersectionGuard");
+  impl_->F = F;
+  impl_->mesh = ToCgal(V, F, "SelfIntersectionGuard");
+  const auto all_faces = faces(impl_->mesh);
+  impl_->allowed = IntersectingPairs(
+      impl_->mesh, std::vector<Mesh::Face_index>(all_faces.begin(), all_faces.end()));
+}
+
+SelfIntersectionGuard::~SelfIntersectionGuard() = default;
+
+const std::vector<std::pair<int, int>>& SelfIntersectionGuard::initial_pairs() const {
+  return impl_->allowed;
+}
+
+UndoSelfIntersectionsSummary SelfIntersectionGuard::Undo(const Eigen::MatrixXd& V_before,
+                                                         Eigen::MatrixXd* V_after) {
+  CheckUndoInput(V_before, impl_->F, impl_->allowed, V_after);
+  return UndoOnMesh(V_before, impl_->F, impl_->allowed, &impl_->mesh, V_after);
 }
 
 }  // namespace mr

@@ -14,9 +14,11 @@
 //
 // Library: mr_remesh (links CGAL; keep it out of mr_geometry).
 
-#include <Eigen/Core>
+#include <memory>
 #include <string>
 #include <vector>
+
+#include <Eigen/Core>
 
 namespace mr {
 
@@ -240,6 +242,27 @@ struct UndoSelfIntersectionsSummary {
 UndoSelfIntersectionsSummary UndoSelfIntersections(
     const Eigen::MatrixXd& V_before, const Eigen::MatrixXi& F,
     const std::vector<std::pair<int, int>>& allowed, Eigen::MatrixXd* V_after);
+
+// UndoSelfIntersections for a loop of motions over one connectivity: the
+// CGAL structure is built once (not per call), and the pairs the mesh has
+// when the guard is made are the allowed ones.
+class SelfIntersectionGuard {
+ public:
+  // F must be an oriented 2-manifold (throws InputError otherwise).
+  SelfIntersectionGuard(const Eigen::MatrixXd& V, const Eigen::MatrixXi& F);
+  ~SelfIntersectionGuard();
+  SelfIntersectionGuard(const SelfIntersectionGuard&) = delete;
+  SelfIntersectionGuard& operator=(const SelfIntersectionGuard&) = delete;
+
+  // Intersecting pairs (a < b, sorted) of the mesh the guard was made with.
+  const std::vector<std::pair<int, int>>& initial_pairs() const;
+  // UndoSelfIntersections(V_before, F, initial_pairs(), V_after).
+  UndoSelfIntersectionsSummary Undo(const Eigen::MatrixXd& V_before, Eigen::MatrixXd* V_after);
+
+ private:
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+};
 
 // ---------------------------------------------------------------------------
 // Flipped faces (Eigen only): faces whose normal turned by more than

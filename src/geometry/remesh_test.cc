@@ -539,6 +539,39 @@ TEST(SelfIntersections, UndoLeavesNoneAfterManyWildMoves) {
   EXPECT_GE(most_rounds, 2);  // the local rounds did run
 }
 
+TEST(SelfIntersections, GuardEqualsUndoOverManyMotions) {
+  // The guard keeps one CGAL mesh over many calls; each call must give what
+  // the stateless function gives with the guard's initial pairs allowed.
+  Eigen::MatrixXd V;
+  Eigen::MatrixXi F;
+  PiercedSphere(&V, &F);  // starts with allowed pairs
+  SelfIntersectionGuard guard(V, F);
+  EXPECT_EQ(guard.initial_pairs(), CountSelfIntersections(V, F, true).pairs);
+  std::mt19937 rng(11);
+  std::uniform_int_distribution<int> pick(0, static_cast<int>(V.rows()) - 1);
+  std::normal_distribution<double> normal(0.0, 0.3);
+  Eigen::MatrixXd current = V;
+  int total_reset = 0;
+  for (int step = 0; step < 4; ++step) {
+    Eigen::MatrixXd moved = current;
+    for (int i = 0; i < 20; ++i) {
+      moved.row(pick(rng)) += Eigen::RowVector3d(normal(rng), normal(rng), normal(rng));
+    }
+    Eigen::MatrixXd by_guard = moved, by_function = moved;
+    const UndoSelfIntersectionsSummary g = guard.Undo(current, &by_guard);
+    const UndoSelfIntersectionsSummary u =
+        UndoSelfIntersections(current, F, guard.initial_pairs(), &by_function);
+    EXPECT_EQ(by_guard, by_function) << "step " << step;
+    EXPECT_EQ(g.initial_pairs, u.initial_pairs);
+    EXPECT_EQ(g.reset_vertices, u.reset_vertices);
+    total_reset += g.reset_vertices;
+    current = by_guard;
+  }
+  EXPECT_GT(total_reset, 0);  // the motions did intersect
+  Eigen::MatrixXd short_v = V.topRows(5);
+  EXPECT_THROW(guard.Undo(V, &short_v), InputError);
+}
+
 TEST(SelfIntersections, UndoKeepsAllowedPairs) {
   // A mesh that already intersects: its pairs are allowed, so a harmless
   // motion is kept entirely; without the allowance the warning path stops.

@@ -323,16 +323,15 @@ RefineSummary RefineMesh(const ViewSource& source, const RefineOptions& options,
     guard_verified_clean = false;
     // The iterations start from a mesh without self-intersections (what the
     // repair cannot remove is tolerated, and only new ones are undone).
-    std::vector<std::pair<int, int>> allowed_pairs;
+    std::unique_ptr<SelfIntersectionGuard> guard;
     if (options.prevent_self_intersections) {
-      SelfIntersectionReport start = CountSelfIntersections(V, F, true);
-      if (start.intersecting_pairs > 0) {
-        MR_LOG(INFO) << "Level " << level << " starts with " << start.intersecting_pairs
+      guard = std::make_unique<SelfIntersectionGuard>(V, F);
+      if (!guard->initial_pairs().empty()) {
+        MR_LOG(INFO) << "Level " << level << " starts with " << guard->initial_pairs().size()
                      << " intersecting face pairs; repairing";
         RemoveSelfIntersections(&V, &F);
-        start = CountSelfIntersections(V, F, true);
+        guard = std::make_unique<SelfIntersectionGuard>(V, F);
       }
-      allowed_pairs = std::move(start.pairs);
     }
     RenderCache renders(renderer, views, cache_bytes / 2);
     MR_LOG(INFO) << "Level " << level << ": " << views[0].width << "x" << views[0].height
@@ -418,16 +417,15 @@ RefineSummary RefineMesh(const ViewSource& source, const RefineOptions& options,
       const double t_cleanup = ElapsedSeconds();
       record.denoise_seconds = t_cleanup - t_denoise;
       summary.flipped_faces_fixed += FixFlippedFaces(V_before, F, &V).initial_flipped;
-      if (options.prevent_self_intersections) {
-        const UndoSelfIntersectionsSummary undone =
-            UndoSelfIntersections(V_before, F, allowed_pairs, &V);
+      if (guard) {
+        const UndoSelfIntersectionsSummary undone = guard->Undo(V_before, &V);
         summary.self_intersections_undone += undone.initial_pairs;
         summary.vertices_reset += undone.reset_vertices;
         if (undone.initial_pairs > 0) {
           MR_LOG(INFO) << "UndoSelfIntersections: " << undone.BriefReport();
         }
       }
-      guard_verified_clean = options.prevent_self_intersections && allowed_pairs.empty();
+      guard_verified_clean = guard && guard->initial_pairs().empty();
 
       record.cleanup_seconds = ElapsedSeconds() - t_cleanup;
       record.seconds = ElapsedSeconds() - t_iter;
