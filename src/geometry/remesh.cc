@@ -309,6 +309,36 @@ std::string SelfIntersectionReport::BriefReport() const {
   return s.str();
 }
 
+namespace {
+
+// The intersecting face pairs (a < b, sorted) among the faces of `range`
+// (CGAL's test; a fresh mesh from ToCgal, so face index == row of F).
+std::vector<std::pair<int, int>> IntersectingPairs(const Mesh& mesh,
+                                                   const std::vector<Mesh::Face_index>& range,
+                                                   const char* what) {
+  std::vector<std::pair<Mesh::Face_index, Mesh::Face_index>> found;
+  RunCgal(what, [&] {
+    PMP::self_intersections<CGAL::Parallel_if_available_tag>(range, mesh,
+                                                             std::back_inserter(found));
+  });
+  std::vector<std::pair<int, int>> pairs;
+  pairs.reserve(found.size());
+  for (const auto& p : found) {
+    const int a = static_cast<int>(p.first.idx()), b = static_cast<int>(p.second.idx());
+    pairs.emplace_back(std::min(a, b), std::max(a, b));
+  }
+  std::sort(pairs.begin(), pairs.end());
+  return pairs;
+}
+
+// The same over the whole mesh.
+std::vector<std::pair<int, int>> IntersectingPairs(const Mesh& mesh, const char* what) {
+  const auto all = faces(mesh);
+  return IntersectingPairs(mesh, std::vector<Mesh::Face_index>(all.begin(), all.end()), what);
+}
+
+}  // namespace
+
 SelfIntersectionReport CountSelfIntersections(const Eigen::MatrixXd& V, const Eigen::MatrixXi& F,
                                               bool keep_pairs) {
   CheckMeshInput(V, F, "CountSelfIntersections");
@@ -316,26 +346,19 @@ SelfIntersectionReport CountSelfIntersections(const Eigen::MatrixXd& V, const Ei
   SelfIntersectionReport report;
   report.parallel = std::is_same<CGAL::Parallel_if_available_tag, CGAL::Parallel_tag>::value;
   if (F.rows() == 0) return report;
-  const Mesh mesh = ToCgal(V, F, "CountSelfIntersections");
-  std::vector<std::pair<Mesh::Face_index, Mesh::Face_index>> pairs;
-  RunCgal("CountSelfIntersections", [&] {
-    PMP::self_intersections<CGAL::Parallel_if_available_tag>(faces(mesh), mesh,
-                                                             std::back_inserter(pairs));
-  });
+  std::vector<std::pair<int, int>> pairs =
+      IntersectingPairs(ToCgal(V, F, "CountSelfIntersections"), "CountSelfIntersections");
   report.intersecting_pairs = static_cast<long>(pairs.size());
   std::vector<int> involved;
   involved.reserve(2 * pairs.size());
-  for (const auto& p : pairs) {
-    // Fresh mesh: face index == row of F (see ToCgal).
-    const int a = static_cast<int>(p.first.idx()), b = static_cast<int>(p.second.idx());
+  for (const auto& [a, b] : pairs) {
     involved.push_back(a);
     involved.push_back(b);
-    if (keep_pairs) report.pairs.emplace_back(std::min(a, b), std::max(a, b));
   }
   std::sort(involved.begin(), involved.end());
   report.intersecting_faces =
       static_cast<int>(std::unique(involved.begin(), involved.end()) - involved.begin());
-  if (keep_pairs) std::sort(report.pairs.begin(), report.pairs.end());
+  if (keep_pairs) report.pairs = std::move(pairs);
   report.seconds = ElapsedSeconds() - t0;
   MR_LOG(VERBOSE) << "CountSelfIntersections: " << report.BriefReport();
   return report;
@@ -430,25 +453,6 @@ RemoveSelfIntersectionsSummary RemoveSelfIntersections(
 
 namespace {
 
-// The intersecting face pairs (a < b, sorted) among the faces of `range`
-// (CGAL's test; a fresh mesh from ToCgal, so face index == row of F).
-std::vector<std::pair<int, int>> IntersectingPairs(const Mesh& mesh,
-                                                   const std::vector<Mesh::Face_index>& range) {
-  std::vector<std::pair<Mesh::Face_index, Mesh::Face_index>> found;
-  RunCgal("UndoSelfIntersections", [&] {
-    PMP::self_intersections<CGAL::Parallel_if_available_tag>(range, mesh,
-                                                             std::back_inserter(found));
-  });
-  std::vector<std::pair<int, int>> pairs;
-  pairs.reserve(found.size());
-  for (const auto& p : found) {
-    const int a = static_cast<int>(p.first.idx()), b = static_cast<int>(p.second.idx());
-    pairs.emplace_back(std::min(a, b), std::max(a, b));
-  }
-  std::sort(pairs.begin(), pairs.end());
-  return pairs;
-}
-
 // The range that holds every pair involving a face of `faces`: those faces
 // and every face whose bounding box overlaps one of theirs
 // (box_intersection_d), so the rest of the mesh is skipped.
@@ -521,11 +525,11 @@ UndoSelfIntersectionsSummary UndoOnMesh(const Eigen::MatrixXd& V_before, const E
   // mesh) check, new pairs can only involve these.
   std::vector<int> changed_faces;
   std::vector<std::vector<int>> vertex_faces;
-  const auto all_faces = faces(mesh);
   for (bool first = true;; first = false) {
-    const std::vector<std::pair<int, int>> pairs = IntersectingPairs(
-        mesh, first ? std::vector<Mesh::Face_index>(all_faces.begin(), all_faces.end())
-                    : FacesNear(*V_after, F, changed_faces));
+    const std::vector<std::pair<int, int>> pairs =
+        first ? IntersectingPairs(mesh, "UndoSelfIntersections")
+              : IntersectingPairs(mesh, FacesNear(*V_after, F, changed_faces),
+                                  "UndoSelfIntersections");
     std::vector<int> offending;  // faces of new pairs, then flipped faces
     long new_pairs = 0;
     for (const auto& p : pairs) {
@@ -597,9 +601,7 @@ SelfIntersectionGuard::SelfIntersectionGuard(const Eigen::MatrixXd& V, const Eig
   CheckMeshInput(V, F, "SelfIntersectionGuard");
   impl_->F = F;
   impl_->mesh = ToCgal(V, F, "SelfIntersectionGuard");
-  const auto all_faces = faces(impl_->mesh);
-  impl_->allowed = IntersectingPairs(
-      impl_->mesh, std::vector<Mesh::Face_index>(all_faces.begin(), all_faces.end()));
+  impl_->allowed = IntersectingPairs(impl_->mesh, "SelfIntersectionGuard");
 }
 
 SelfIntersectionGuard::~SelfIntersectionGuard() = default;

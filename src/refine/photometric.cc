@@ -136,12 +136,10 @@ void WarpImage(const MeshGeometry& mesh, const PinholeView& view_i, const Render
     for (int col = 0; col < view_i.width; ++col) {
       if (!WarpPixel(mesh, view_i, render_i, view_j, render_j, options, row, col, &warp)) continue;
       mask->at<uint8_t>(row, col) = 255;
-      if (derivative == nullptr) {
-        predicted->at<double>(row, col) = SampleBilinear(image_j, warp.q.x(), warp.q.y(), nullptr);
-        continue;
-      }
       Eigen::Vector2d grad_j;
-      predicted->at<double>(row, col) = SampleBilinear(image_j, warp.q.x(), warp.q.y(), &grad_j);
+      predicted->at<double>(row, col) = SampleBilinear(image_j, warp.q.x(), warp.q.y(),
+                                                       derivative != nullptr ? &grad_j : nullptr);
+      if (derivative == nullptr) continue;
       const int f = render_i.face_id[static_cast<size_t>(row) * render_i.width + col];
       const Eigen::Vector3d n = mesh.face_normals.row(f);
       derivative->at<double>(row, col) = grad_j.dot(warp.jacobian_j * warp.ray) / n.dot(warp.ray);

@@ -10,6 +10,7 @@
 #include "util/error.h"
 
 namespace mr {
+namespace {
 
 void KeepFreedBuffersInProcess() {
 #if defined(__GLIBC__)
@@ -18,7 +19,7 @@ void KeepFreedBuffersInProcess() {
   // megabytes at a high rate. By default glibc serves each large one from a
   // fresh mmap and unmaps it on free, so every use pays the page faults of
   // touching it again. Measured: the example's initial similarity 9 s -> 5 s;
-  // the L_p denoiser on 1M faces 35 s -> 15 s and on 3M faces 134 s -> 42 s
+  // the L_p denoiser on 1M faces 35 s -> 16 s and on 3M faces 134 s -> 47 s
   // (52 s of it in the kernel before). So everything comes from the heap and
   // is reused, and up to 512 MB of free heap is kept before trimming; peak
   // memory is unchanged in those runs.
@@ -26,6 +27,8 @@ void KeepFreedBuffersInProcess() {
   mallopt(M_TRIM_THRESHOLD, 512 << 20);
 #endif
 }
+
+}  // namespace
 
 int RunProgram(const std::function<int()>& body) {
   KeepFreedBuffersInProcess();
