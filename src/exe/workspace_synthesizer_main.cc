@@ -38,9 +38,18 @@ int main(int argc, char** argv) {
     options.Add("height", &o.cameras.height, "image height (pixels)");
     options.Add("layout", &o.cameras.layout, "camera layout: ring or hemisphere");
     options.Add("elevation_deg", &o.cameras.elevation_deg, "ring elevation (degrees)");
+    options.Add("min_elevation_deg", &o.cameras.min_elevation_deg,
+                "hemisphere layout: lowest elevation (degrees)");
+    options.Add("max_elevation_deg", &o.cameras.max_elevation_deg,
+                "hemisphere layout: highest elevation (degrees)");
+    options.Add("focal_factor", &o.cameras.focal_factor,
+                "focal length as a multiple of the image width");
     options.Add("fill_fraction", &o.cameras.fill_fraction,
                 "fraction of the image height the object's bounding sphere fills");
     options.Add("supersample", &o.supersample, "supersampling factor per axis (anti-aliasing)");
+    options.Add("image_noise", &o.image_noise,
+                "Gaussian image noise per pixel and channel (standard deviation, radiance in "
+                "[0, 1])");
     options.Add("write_masks", &o.write_masks, "write dense/masks/<image>.png");
     options.Add("num_sparse_points", &o.num_sparse_points, "maximum number of sparse points3D");
     options.Add("seed", &o.seed, "random seed");
@@ -55,8 +64,16 @@ int main(int argc, char** argv) {
     options.Add("outlier_fraction", &o.noise.outlier_fraction,
                 "fraction of depth pixels that are outliers");
     options.Add("normal_noise", &o.noise.normal_noise, "normal noise (radians, approx.)");
+    options.Add("texture_style", &o.appearance.texture_style,
+                "texture: contrast (grey, high contrast), smooth_color (colour, low luminance "
+                "contrast) or none (uniform; shading only)");
     options.Add("texture_scale", &o.appearance.texture_scale,
                 "finest texture period (scene units)");
+    options.Add("texture_contrast", &o.appearance.texture_contrast,
+                "contrast gain of the contrast texture (tanh steepness)");
+    options.Add("light", &o.appearance.light,
+                "light: world (fixed world direction) or headlight (at the camera)");
+    options.Add("ambient", &o.appearance.ambient, "ambient share of the lighting, [0, 1]");
     options.Add("Shape.edge_length", &o.builtin.edge_length,
                 "built-in shape: target edge length (scene units)");
     options.Add("Shape.relief_amplitude", &o.builtin.relief_amplitude,

@@ -115,11 +115,13 @@ Eigen::Vector3d BufferPoint(const SynthScene& scene, const RenderBuffers& buffer
          u * scene.V.row(scene.F(f, 1)).transpose() + v * scene.V.row(scene.F(f, 2)).transpose();
 }
 
-double ShadeBufferPixel(const SynthScene& scene, const RenderBuffers& buffers, size_t index) {
+std::optional<Eigen::Vector3d> ShadeBufferPixel(const SynthScene& scene,
+                                                const RenderBuffers& buffers, size_t index,
+                                                const Eigen::Vector3d& eye) {
   const int f = buffers.face_id[index];
-  if (f < 0) return -1;
+  if (f < 0) return std::nullopt;
   return ShadePoint(scene.appearance, BufferPoint(scene, buffers, index),
-                    scene.face_normals.row(f).transpose());
+                    scene.face_normals.row(f).transpose(), eye);
 }
 
 SynthImage RenderImage(Renderer& renderer, const SynthScene& scene, const PinholeView& view,
@@ -133,30 +135,48 @@ SynthImage RenderImage(Renderer& renderer, const SynthScene& scene, const Pinhol
   image.width = view.width;
   image.height = view.height;
   const size_t n = static_cast<size_t>(view.width) * view.height;
-  image.radiance.assign(n, 0.f);
+  image.radiance.assign(3 * n, 0.f);
   image.coverage.assign(n, 0.f);
   const double inv = 1.0 / (supersample * supersample);
+  const Eigen::Vector3d eye = view.Center();
 #pragma omp parallel for schedule(dynamic, 4)
   for (int row = 0; row < view.height; ++row) {
     for (int col = 0; col < view.width; ++col) {
-      double sum = 0, covered = 0;
+      Eigen::Vector3d sum = Eigen::Vector3d::Zero();
+      double covered = 0;
       for (int a = 0; a < supersample; ++a) {
         for (int b = 0; b < supersample; ++b) {
           const size_t idx =
               static_cast<size_t>(row * supersample + a) * hi.width + col * supersample + b;
-          const double value = ShadeBufferPixel(scene, buffers, idx);
-          if (value >= 0) {
-            sum += value;
+          const std::optional<Eigen::Vector3d> value =
+              ShadeBufferPixel(scene, buffers, idx, eye);
+          if (value) {
+            sum += *value;
             covered += 1;
           }
         }
       }
       const size_t out = static_cast<size_t>(row) * view.width + col;
-      image.radiance[out] = static_cast<float>(sum * inv);
+      for (int c = 0; c < 3; ++c) image.radiance[3 * out + c] = static_cast<float>(sum(c) * inv);
       image.coverage[out] = static_cast<float>(covered * inv);
     }
   }
   return image;
+}
+
+void AddImageNoise(double sigma, uint32_t seed, uint32_t view_index, SynthImage* image) {
+  MR_CHECK(image != nullptr);
+  MR_CHECK(sigma >= 0 && sigma <= 0.5) << "image noise sigma " << sigma;
+  MR_CHECK_EQ(image->radiance.size(), 3 * image->coverage.size());
+  if (sigma == 0) return;
+  // A seed sequence of its own, so that the image noise is independent of
+  // the depth-map noise of the same view.
+  std::seed_seq sequence{seed, view_index, 0x696d6731u};
+  std::mt19937 rng(sequence);
+  std::normal_distribution<double> gauss(0.0, sigma);
+  for (float& value : image->radiance) {
+    value = static_cast<float>(std::clamp(value + gauss(rng), 0.0, 1.0));
+  }
 }
 
 bool DepthNoiseOptions::Check() const {
@@ -355,7 +375,7 @@ Reconstruction MakeSparseModel(const SynthScene& scene, const std::vector<Pinhol
     point.point3D_id = next_id++;
     point.xyz = X;
     point.error = 0.0;
-    double gray = 0;
+    Eigen::Vector3d rgb = Eigen::Vector3d::Zero();
     for (const auto& [i, p] : seen) {
       Image& image = model.images.at(static_cast<uint32_t>(i + 1));
       Point2D p2;
@@ -365,10 +385,13 @@ Reconstruction MakeSparseModel(const SynthScene& scene, const std::vector<Pinhol
       image.points2D.push_back(p2);
       const int col = std::clamp(static_cast<int>(p.x()), 0, images[i].width - 1);
       const int row = std::clamp(static_cast<int>(p.y()), 0, images[i].height - 1);
-      gray += images[i].radiance[static_cast<size_t>(row) * images[i].width + col];
+      const size_t pixel = static_cast<size_t>(row) * images[i].width + col;
+      for (int c = 0; c < 3; ++c) rgb(c) += images[i].radiance[3 * pixel + c];
     }
-    const uint8_t g = static_cast<uint8_t>(std::clamp(255.0 * gray / seen.size(), 0.0, 255.0));
-    point.rgb << g, g, g;
+    for (int c = 0; c < 3; ++c) {
+      point.rgb(c) =
+          static_cast<uint8_t>(std::clamp(255.0 * rgb(c) / seen.size(), 0.0, 255.0));
+    }
     model.points3D[point.point3D_id] = point;
   }
   return model;

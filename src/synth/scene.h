@@ -4,6 +4,7 @@
 // noisy COLMAP-style depth/normal maps and the sparse model's tracks.
 
 #include <cstdint>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -57,24 +58,34 @@ struct SynthScene {
   AppearanceOptions appearance;
 };
 
-// Radiance of the surface seen in one render-buffer pixel (-1 for background).
-double ShadeBufferPixel(const SynthScene& scene, const RenderBuffers& buffers, size_t index);
+// RGB radiance of the surface seen in one render-buffer pixel of a view
+// whose camera centre is `eye` (the headlight's position); nullopt for
+// background.
+std::optional<Eigen::Vector3d> ShadeBufferPixel(const SynthScene& scene,
+                                                const RenderBuffers& buffers, size_t index,
+                                                const Eigen::Vector3d& eye);
 // Surface point seen in one render-buffer pixel (face_id must be >= 0).
 Eigen::Vector3d BufferPoint(const SynthScene& scene, const RenderBuffers& buffers, size_t index);
 
-// An anti-aliased grayscale image: row-major radiance in [0, 1] and, per
-// pixel, the fraction of sub-pixels that saw the object.
+// An anti-aliased RGB image: row-major, interleaved radiance in [0, 1]
+// (channel c of pixel i at 3 * i + c; R = G = B for the grey texture styles)
+// and, per pixel, the fraction of sub-pixels that saw the object.
 struct SynthImage {
   int width = 0;
   int height = 0;
-  std::vector<float> radiance;
-  std::vector<float> coverage;
+  std::vector<float> radiance;  // 3 * width * height
+  std::vector<float> coverage;  // width * height
 };
 
 // Renders `view` at `supersample` times its resolution (the renderer must
 // hold scene.V/F) and box-filters down to the view's resolution.
 SynthImage RenderImage(Renderer& renderer, const SynthScene& scene, const PinholeView& view,
                        int supersample);
+
+// Adds white Gaussian noise of standard deviation `sigma` to every channel of
+// every pixel (background too, like a camera's read noise) and clamps to
+// [0, 1]. The noise depends only on (seed, view_index). sigma in [0, 0.5].
+void AddImageNoise(double sigma, uint32_t seed, uint32_t view_index, SynthImage* image);
 
 struct DepthNoiseOptions {
   // Standard deviation of the per-pixel Gaussian depth noise, relative to
@@ -116,8 +127,8 @@ DenseMaps RenderDenseMaps(Renderer& renderer, const SynthScene& scene, const Pin
 // Sparse model: one PINHOLE camera (id 1), images 1..n named `names`, and up
 // to `num_points` surface points (area-uniform samples) that are visible in
 // at least two views, with tracks and matching points2D. Visibility uses the
-// exact dense-convention renders (`exact[i]` for view i). Colours come from
-// `images`.
+// exact dense-convention renders (`exact[i]` for view i). Colours (RGB) are
+// the mean over the track of the pixels of `images` that the point projects into.
 Reconstruction MakeSparseModel(const SynthScene& scene, const std::vector<PinholeView>& views,
                                const std::vector<std::string>& names,
                                const std::vector<RenderBuffers>& exact,

@@ -3,6 +3,9 @@
 #include <algorithm>
 #include <cmath>
 #include <numeric>
+#include <optional>
+#include <string>
+#include <utility>
 #include <vector>
 
 #include <Eigen/Geometry>
@@ -83,15 +86,18 @@ TEST(RenderImage, NonBlackExactlyWhereObjectProjects) {
   for (const PinholeView& view : views) {
     const SynthImage image = RenderImage(renderer, scene, view, 3);
     int covered = 0, vertex_hits = 0, vertex_total = 0;
-    for (size_t i = 0; i < image.radiance.size(); ++i) {
-      if (image.coverage[i] == 0) {
-        ASSERT_EQ(image.radiance[i], 0.f);
-      } else {
-        ASSERT_GT(image.radiance[i], 0.f);
-        ++covered;
+    ASSERT_EQ(image.radiance.size(), 3 * image.coverage.size());
+    for (size_t i = 0; i < image.coverage.size(); ++i) {
+      for (int c = 0; c < 3; ++c) {
+        if (image.coverage[i] == 0) {
+          ASSERT_EQ(image.radiance[3 * i + c], 0.f);
+        } else {
+          ASSERT_GT(image.radiance[3 * i + c], 0.f);
+        }
       }
+      if (image.coverage[i] > 0) ++covered;
     }
-    EXPECT_GT(covered, 0.1 * image.radiance.size());
+    EXPECT_GT(covered, 0.1 * image.coverage.size());
     for (int v = 0; v < scene.V.rows(); ++v) {
       const Eigen::Vector2d p = view.Project(scene.V.row(v).transpose());
       if (!view.InImage(p)) continue;
@@ -105,34 +111,143 @@ TEST(RenderImage, NonBlackExactlyWhereObjectProjects) {
 
 // The image at pixel (col, row) must show the texture-predicted radiance of
 // the surface point seen through the pixel centre (col + 0.5, row + 0.5),
-// found by an independent CPU ray cast. A one-pixel shift must be detectably worse.
+// found by an independent CPU ray cast. A one-pixel shift must be detectably
+// worse. The colour texture lit by the headlight must match as well, in
+// every channel (a swapped channel or a light from elsewhere would not).
 TEST(RenderImage, PixelsMatchTexturePrediction) {
-  SynthScene scene = CoarseScene();
-  scene.appearance.texture_scale = 2.5;  // features of several pixels at 320x240
-  const std::vector<PinholeView> views = SmallRing(scene, 320, 240);
+  for (const std::string style : {"contrast", "smooth_color"}) {
+    SynthScene scene = CoarseScene();
+    scene.appearance.texture_style = style;
+    if (style == "contrast") {
+      scene.appearance.texture_scale = 2.5;  // features of several pixels at 320x240
+    } else {
+      scene.appearance.texture_scale = 0.3;  // smooth_color's periods are 8-16x longer
+      scene.appearance.light = "headlight";
+    }
+    const std::vector<PinholeView> views = SmallRing(scene, 320, 240);
+    Renderer renderer;
+    renderer.SetMesh(scene.V, scene.F);
+    const PinholeView& view = views[1];
+    const SynthImage image = RenderImage(renderer, scene, view, 3);
+    const RenderBuffers ref = RenderCpu(scene.V, scene.F, view);
+    double err = 0, err_shift = 0;
+    int n = 0;
+    for (int row = 1; row + 1 < view.height; ++row) {
+      for (int col = 1; col + 2 < view.width; ++col) {
+        const size_t idx = static_cast<size_t>(row) * view.width + col;
+        if (image.coverage[idx] < 1 || image.coverage[idx + 1] < 1) continue;
+        const std::optional<Eigen::Vector3d> predicted =
+            ShadeBufferPixel(scene, ref, idx, view.Center());
+        ASSERT_TRUE(predicted.has_value());
+        for (int c = 0; c < 3; ++c) {
+          err += std::abs(image.radiance[3 * idx + c] - (*predicted)(c)) / 3;
+          err_shift += std::abs(image.radiance[3 * (idx + 1) + c] - (*predicted)(c)) / 3;
+        }
+        ++n;
+      }
+    }
+    ASSERT_GT(n, 1000);
+    err /= n;
+    err_shift /= n;
+    EXPECT_LT(err, 0.02) << style << ": mean |image - prediction| (radiance in [0, 1])";
+    EXPECT_GT(err_shift, 2 * err) << style;
+  }
+}
+
+// A 200 x 200 square in the plane z = 0, normal +z, filling the view from
+// (0, 0, 100) straight down, whose optical axis passes through the centre of
+// pixel (32, 24).
+TEST(RenderImage, HeadlightFullyLightsAPatchFacingTheCamera) {
+  SynthScene scene;
+  scene.V.resize(4, 3);
+  scene.V << -100, -100, 0, 100, -100, 0, 100, 100, 0, -100, 100, 0;
+  scene.F.resize(2, 3);
+  scene.F << 0, 1, 2, 0, 2, 3;
+  scene.face_normals = FaceNormals(scene.V, scene.F);
+  ASSERT_NEAR(scene.face_normals(0, 2), 1, 1e-12);
+  scene.appearance.texture_style = "none";
+  scene.appearance.ambient = 0.25;
+  scene.appearance.light = "headlight";
+  PinholeView view;
+  view.width = 64;
+  view.height = 48;
+  view.fx = view.fy = 60;
+  view.cx = 32.5;
+  view.cy = 24.5;
+  view.R << 1, 0, 0, 0, -1, 0, 0, 0, -1;
+  const Eigen::Vector3d eye(0, 0, 100);
+  view.t = -view.R * eye;
   Renderer renderer;
   renderer.SetMesh(scene.V, scene.F);
-  const PinholeView& view = views[1];
-  const SynthImage image = RenderImage(renderer, scene, view, 3);
-  const RenderBuffers ref = RenderCpu(scene.V, scene.F, view);
-  double err = 0, err_shift = 0;
-  int n = 0;
-  for (int row = 1; row + 1 < view.height; ++row) {
-    for (int col = 1; col + 2 < view.width; ++col) {
-      const size_t idx = static_cast<size_t>(row) * view.width + col;
-      if (image.coverage[idx] < 1 || image.coverage[idx + 1] < 1) continue;
-      const double predicted = ShadeBufferPixel(scene, ref, idx);
-      ASSERT_GE(predicted, 0);
-      err += std::abs(image.radiance[idx] - predicted);
-      err_shift += std::abs(image.radiance[idx + 1] - predicted);
+  const SynthImage image = RenderImage(renderer, scene, view, 1);
+  const auto radiance = [&](int row, int col) {
+    const size_t i = static_cast<size_t>(row) * view.width + col;
+    EXPECT_EQ(image.coverage[i], 1.f);
+    return Eigen::Vector3d(image.radiance[3 * i], image.radiance[3 * i + 1],
+                           image.radiance[3 * i + 2]);
+  };
+  const AppearanceOptions& a = scene.appearance;
+  const Eigen::Vector3d centre = radiance(24, 32);
+  const Eigen::Vector3d albedo = Albedo(a, Eigen::Vector3d::Zero());
+  EXPECT_NEAR((centre - albedo * (a.ambient + (1 - a.ambient) * 1)).cwiseAbs().maxCoeff(), 0,
+              1e-6);
+  // Off the axis the directional share falls with the cosine of the angle
+  // between the normal and the direction to the camera.
+  for (const auto& [row, col] : {std::pair(2, 3), std::pair(40, 60), std::pair(10, 50)}) {
+    const Eigen::Vector3d ray = view.RayDirection(col + 0.5, row + 0.5);
+    const Eigen::Vector3d p = eye + (-eye.z() / ray.z()) * ray;
+    const double cosine = (eye - p).normalized().z();
+    ASSERT_LT(cosine, 0.95);
+    EXPECT_NEAR(
+        (radiance(row, col) - Albedo(a, p) * (a.ambient + (1 - a.ambient) * cosine))
+            .cwiseAbs()
+            .maxCoeff(),
+        0, 1e-5)
+        << row << " " << col;
+  }
+  // The world light (0.4, -0.3, 1) does not light it fully.
+  scene.appearance.light = "world";
+  const SynthImage world = RenderImage(renderer, scene, view, 1);
+  const size_t i = 24 * 64 + 32;
+  EXPECT_LT(world.radiance[3 * i], centre(0) - 0.02);
+}
+
+// White noise of the requested level, ignoring pixels it could clip;
+// reproducible from (seed, view index).
+TEST(AddImageNoise, HasRequestedLevelAndIsDeterministic) {
+  const SynthScene scene = CoarseScene();
+  const std::vector<PinholeView> views = SmallRing(scene);
+  Renderer renderer;
+  renderer.SetMesh(scene.V, scene.F);
+  const SynthImage clean = RenderImage(renderer, scene, views[0], 2);
+  for (const double sigma : {0.01, 0.04}) {
+    SynthImage noisy = clean;
+    AddImageNoise(sigma, 5, 0, &noisy);
+    ASSERT_EQ(noisy.radiance.size(), clean.radiance.size());
+    double sum = 0, sum2 = 0;
+    int n = 0;
+    for (size_t i = 0; i < clean.radiance.size(); ++i) {
+      ASSERT_GE(noisy.radiance[i], 0.f);
+      ASSERT_LE(noisy.radiance[i], 1.f);
+      if (clean.radiance[i] < 4 * sigma || clean.radiance[i] > 1 - 4 * sigma) continue;
+      const double d = noisy.radiance[i] - clean.radiance[i];
+      sum += d;
+      sum2 += d * d;
       ++n;
     }
+    ASSERT_GT(n, 5000);
+    const double mean = sum / n, sd = std::sqrt(sum2 / n - mean * mean);
+    EXPECT_NEAR(sd, sigma, 0.1 * sigma);
+    EXPECT_NEAR(mean, 0, 0.1 * sigma);
   }
-  ASSERT_GT(n, 1000);
-  err /= n;
-  err_shift /= n;
-  EXPECT_LT(err, 0.02) << "mean |image - prediction| (radiance in [0, 1])";
-  EXPECT_GT(err_shift, 2 * err);
+  SynthImage a = clean, b = clean, c = clean, zero = clean;
+  AddImageNoise(0.02, 5, 0, &a);
+  AddImageNoise(0.02, 5, 0, &b);
+  AddImageNoise(0.02, 5, 1, &c);
+  AddImageNoise(0, 5, 0, &zero);
+  EXPECT_EQ(a.radiance, b.radiance);
+  EXPECT_NE(a.radiance, c.radiance);
+  EXPECT_EQ(zero.radiance, clean.radiance);
 }
 
 TEST(RenderDenseMaps, DepthPixelsBackProjectOntoSurfaceWithDenseConvention) {

@@ -1,7 +1,9 @@
 #include "synth/shape.h"
 
+#include <algorithm>
 #include <cmath>
 #include <map>
+#include <string>
 #include <utility>
 
 #include <Eigen/Geometry>
@@ -141,13 +143,78 @@ TEST(NormalizeMesh, EmptyMesh) {
   EXPECT_THROW(NormalizeMesh(100, &P), InputError);
 }
 
+TEST(AppearanceOptions, RejectsBadValues) {
+  AppearanceOptions options;
+  options.texture_style = "marble";
+  EXPECT_THROW(options.Check(), InputError);
+  options = AppearanceOptions();
+  options.light = "sun";
+  EXPECT_THROW(options.Check(), InputError);
+  for (const double contrast : {0.0, -1.0, 101.0, std::nan("")}) {
+    options = AppearanceOptions();
+    options.texture_contrast = contrast;
+    EXPECT_THROW(options.Check(), InputError) << contrast;
+  }
+  for (const double ambient : {-0.1, 1.5, std::nan("")}) {
+    options = AppearanceOptions();
+    options.ambient = ambient;
+    EXPECT_THROW(options.Check(), InputError) << ambient;
+  }
+  for (const std::string style : {"contrast", "smooth_color", "none"}) {
+    options = AppearanceOptions();
+    options.texture_style = style;
+    options.light = "headlight";
+    EXPECT_TRUE(options.Check()) << style;
+  }
+}
+
+// Surface points of the coarse built-in shape.
+Eigen::MatrixXd SurfacePoints() { return CoarseShape().V; }
+
+struct AlbedoStats {
+  double luminance_sd = 0;
+  double red_minus_green_sd = 0;
+  double max_channel_sd = 0;
+  double max_channel_spread = 0;  // largest |R - G|, |G - B|
+  double lo = 1, hi = 0;
+  // Mean |albedo(p) - albedo(p + 0.4 x)| (max over channels): fine-scale contrast.
+  double neighbour_difference = 0;
+};
+
+AlbedoStats Stats(const AppearanceOptions& options, const Eigen::MatrixXd& P) {
+  const int n = static_cast<int>(P.rows());
+  Eigen::MatrixXd values(n, 5);  // R, G, B, luminance, R - G
+  AlbedoStats stats;
+  for (int i = 0; i < n; ++i) {
+    const Eigen::Vector3d p = P.row(i).transpose();
+    const Eigen::Vector3d a = Albedo(options, p);
+    values.row(i) << a.transpose(), Luminance(a), a(0) - a(1);
+    stats.lo = std::min(stats.lo, a.minCoeff());
+    stats.hi = std::max(stats.hi, a.maxCoeff());
+    stats.max_channel_spread =
+        std::max({stats.max_channel_spread, std::abs(a(0) - a(1)), std::abs(a(1) - a(2))});
+    stats.neighbour_difference +=
+        (a - Albedo(options, p + Eigen::Vector3d(0.4, 0, 0))).cwiseAbs().maxCoeff() / n;
+  }
+  const Eigen::RowVectorXd mean = values.colwise().mean();
+  const Eigen::RowVectorXd sd =
+      ((values.rowwise() - mean).array().square().colwise().sum() / n).sqrt();
+  stats.max_channel_sd = sd.head(3).maxCoeff();
+  stats.luminance_sd = sd(3);
+  stats.red_minus_green_sd = sd(4);
+  return stats;
+}
+
 TEST(Texture, AlbedoRangeAndContrast) {
   AppearanceOptions options;
   double lo = 1, hi = 0, sum = 0, sum2 = 0;
   const int n = 20000;
   for (int i = 0; i < n; ++i) {
     const Eigen::Vector3d p(0.37 * i, 0.11 * i - 50, 13.0 * std::sin(i));
-    const double a = Albedo(options, p);
+    const Eigen::Vector3d rgb = Albedo(options, p);
+    ASSERT_EQ(rgb(0), rgb(1));
+    ASSERT_EQ(rgb(1), rgb(2));
+    const double a = rgb(0);
     lo = std::min(lo, a);
     hi = std::max(hi, a);
     sum += a;
@@ -161,18 +228,89 @@ TEST(Texture, AlbedoRangeAndContrast) {
   double diff = 0;
   for (int i = 0; i < 1000; ++i) {
     const Eigen::Vector3d p(0.71 * i, 3.1 * std::cos(i), 0.29 * i);
-    diff += std::abs(Albedo(options, p) - Albedo(options, p + Eigen::Vector3d(0.4, 0, 0)));
+    diff += std::abs(Albedo(options, p)(0) - Albedo(options, p + Eigen::Vector3d(0.4, 0, 0))(0));
   }
   EXPECT_GT(diff / 1000, 0.05);
 }
 
+// smooth_color: a quarter of the contrast style's luminance variation at
+// most, clearly varying chroma, smooth at the scale of a few pixels.
+TEST(Texture, SmoothColorHasLowLuminanceContrastAndVaryingChroma) {
+  const Eigen::MatrixXd P = SurfacePoints();
+  ASSERT_GT(P.rows(), 1000);
+  AppearanceOptions contrast;
+  AppearanceOptions smooth;
+  smooth.texture_style = "smooth_color";
+  const AlbedoStats c = Stats(contrast, P), s = Stats(smooth, P);
+  EXPECT_GT(c.luminance_sd, 0.15);
+  EXPECT_EQ(c.max_channel_spread, 0) << "contrast is grey";
+  EXPECT_LT(s.luminance_sd, 0.25 * c.luminance_sd);
+  EXPECT_GT(s.red_minus_green_sd, 0.1) << "chroma must vary";
+  EXPECT_GT(s.max_channel_sd, 0.1);
+  EXPECT_GE(s.lo, smooth.min_albedo);
+  EXPECT_LE(s.hi, smooth.max_albedo);
+  // Relative to its own variation, the albedo changes much less between
+  // points 0.4 units (~2 pixels) apart than the contrast texture does.
+  EXPECT_LT(s.neighbour_difference / s.max_channel_sd,
+            0.5 * c.neighbour_difference / c.max_channel_sd)
+      << "not smooth: " << s.neighbour_difference << " " << s.max_channel_sd << " vs "
+      << c.neighbour_difference << " " << c.max_channel_sd;
+}
+
+// none: (nearly) uniform grey albedo.
+TEST(Texture, NoneIsNearlyUniformGrey) {
+  const Eigen::MatrixXd P = SurfacePoints();
+  AppearanceOptions none;
+  none.texture_style = "none";
+  const AlbedoStats s = Stats(none, P);
+  EXPECT_LT(s.max_channel_sd, 0.02);
+  EXPECT_EQ(s.max_channel_spread, 0) << "none is grey";
+  const double mid = 0.5 * (none.min_albedo + none.max_albedo);
+  EXPECT_GE(s.lo, mid * 0.98 - 1e-12);
+  EXPECT_LE(s.hi, mid * 1.02 + 1e-12);
+}
+
 TEST(Texture, ShadingIsLambertian) {
   AppearanceOptions options;
-  const Eigen::Vector3d p(1, 2, 3);
+  const Eigen::Vector3d p(1, 2, 3), eye(50, -70, 40);
   const Eigen::Vector3d l = options.light_direction.normalized();
-  const double a = Albedo(options, p);
-  EXPECT_NEAR(ShadePoint(options, p, l), a, 1e-12);
-  EXPECT_NEAR(ShadePoint(options, p, -l), a * options.ambient, 1e-12);
+  const Eigen::Vector3d a = Albedo(options, p);
+  EXPECT_NEAR((ShadePoint(options, p, l, eye) - a).norm(), 0, 1e-12);
+  EXPECT_NEAR((ShadePoint(options, p, -l, eye) - a * options.ambient).norm(), 0, 1e-12);
+}
+
+// headlight: a patch facing the camera is fully lit wherever the world light
+// is; one tilted by 60 degrees gets half the directional share.
+TEST(Texture, HeadlightShinesFromTheCamera) {
+  AppearanceOptions options;
+  options.light = "headlight";
+  options.ambient = 0.2;
+  options.texture_style = "smooth_color";
+  AppearanceOptions world = options;
+  world.light = "world";
+  const Eigen::MatrixXd P = SurfacePoints();
+  const Eigen::Vector3d eye(80, -60, 50);
+  int differs_from_world = 0;
+  for (int i = 0; i < P.rows(); i += 7) {
+    const Eigen::Vector3d p = P.row(i).transpose();
+    const Eigen::Vector3d to_eye = (eye - p).normalized();
+    const Eigen::Vector3d a = Albedo(options, p);
+    const Eigen::Vector3d facing = ShadePoint(options, p, to_eye, eye);
+    ASSERT_NEAR((facing - a * (options.ambient + (1 - options.ambient) * 1)).cwiseAbs().maxCoeff(),
+                0, 1e-6);
+    // A normal at 60 degrees from the direction to the camera.
+    const Eigen::Vector3d side = to_eye.unitOrthogonal();
+    const Eigen::Vector3d tilted = 0.5 * to_eye + std::sqrt(0.75) * side;
+    EXPECT_NEAR((ShadePoint(options, p, tilted, eye) -
+                 a * (options.ambient + (1 - options.ambient) * 0.5))
+                    .cwiseAbs()
+                    .maxCoeff(),
+                0, 1e-6);
+    EXPECT_NEAR((ShadePoint(options, p, -to_eye, eye) - a * options.ambient).cwiseAbs().maxCoeff(),
+                0, 1e-12);
+    if ((ShadePoint(world, p, to_eye, eye) - facing).norm() > 0.01) ++differs_from_world;
+  }
+  EXPECT_GT(differs_from_world, 0.5 * (P.rows() / 7));
 }
 
 }  // namespace

@@ -81,6 +81,10 @@ bool SynthesizerOptions::Check() const {
     MR_THROW_INPUT << "SynthesizerOptions::supersample = " << supersample
                    << ". Violated constraint: 1 <= supersample <= 8";
   }
+  if (!(image_noise >= 0 && image_noise <= 0.5)) {
+    MR_THROW_INPUT << "SynthesizerOptions::image_noise = " << image_noise
+                   << ". Violated constraint: 0 <= image_noise <= 0.5";
+  }
   if (num_sparse_points < 0 || num_sparse_points > 10000000) {
     MR_THROW_INPUT << "SynthesizerOptions::num_sparse_points = " << num_sparse_points
                    << ". Violated constraint: 0 <= num_sparse_points <= 1e7";
@@ -118,12 +122,17 @@ std::string SynthViewName(int i) {
 }
 
 void WriteSynthImagePng(const std::string& path, const SynthImage& image) {
+  MR_CHECK_EQ(image.radiance.size(), 3 * static_cast<size_t>(image.width) * image.height);
   cv::Mat mat(image.height, image.width, CV_8UC3);
   for (int row = 0; row < image.height; ++row) {
     for (int col = 0; col < image.width; ++col) {
-      const double v = image.radiance[static_cast<size_t>(row) * image.width + col];
-      const uchar g = static_cast<uchar>(std::clamp(std::lround(255.0 * v), 0L, 255L));
-      mat.at<cv::Vec3b>(row, col) = cv::Vec3b(g, g, g);
+      const size_t pixel = static_cast<size_t>(row) * image.width + col;
+      uchar rgb[3];
+      for (int c = 0; c < 3; ++c) {
+        const double v = image.radiance[3 * pixel + c];
+        rgb[c] = static_cast<uchar>(std::clamp(std::lround(255.0 * v), 0L, 255L));
+      }
+      mat.at<cv::Vec3b>(row, col) = cv::Vec3b(rgb[2], rgb[1], rgb[0]);  // OpenCV is BGR
     }
   }
   WritePng(path, mat);
@@ -189,6 +198,8 @@ SynthesizerSummary SynthesizeWorkspace(const SynthesizerOptions& options) {
     const std::string name = SynthViewName(static_cast<int>(i));
     names.push_back(name);
     SynthImage image = RenderImage(renderer, scene, views[i], options.supersample);
+    AddImageNoise(options.image_noise, static_cast<uint32_t>(options.seed),
+                  static_cast<uint32_t>(i), &image);
     WriteSynthImagePng(JoinPaths(images_dir, name), image);
     if (options.write_masks) {
       cv::Mat mask(image.height, image.width, CV_8UC1);
@@ -217,6 +228,8 @@ SynthesizerSummary SynthesizeWorkspace(const SynthesizerOptions& options) {
   summary.render_seconds = ElapsedSeconds() - t0;
   MR_LOG(INFO) << "Rendered " << views.size() << " views (" << options.cameras.width << "x"
                << options.cameras.height << ", supersample " << options.supersample
+               << ", texture " << options.appearance.texture_style << ", light "
+               << options.appearance.light << ", image noise " << options.image_noise
                << ") with depth and normal maps in " << summary.render_seconds << " s";
 
   // Sparse model.

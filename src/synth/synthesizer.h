@@ -5,7 +5,7 @@
 // Writes, for a ground-truth mesh (loaded, or the built-in shape) normalised
 // to a bounding-box diagonal of `scene_diagonal` units centred at the origin:
 //   output_path/ground_truth.ply          the normalised ground truth
-//   output_path/dense/images/view_NNNN.png   anti-aliased renders
+//   output_path/dense/images/view_NNNN.png   anti-aliased RGB renders
 //   output_path/dense/masks/view_NNNN.png.png  (write_masks) 255 = object
 //   output_path/dense/sparse/{cameras,images,points3D}.bin
 //   output_path/dense/stereo/{depth_maps,normal_maps}/<name>.geometric.bin
@@ -38,6 +38,10 @@ struct SynthesizerOptions {
   double scene_diagonal = 100;
   // Image supersampling factor per axis for anti-aliasing. Range [1, 8].
   int supersample = 3;
+  // Standard deviation of the white Gaussian noise added to every pixel and
+  // channel of the images (radiance in [0, 1], before 8-bit quantisation),
+  // seeded by `seed` and the view index; 0 = none. Range [0, 0.5].
+  double image_noise = 0;
   // Write COLMAP masks (dense/masks/<image name>.png).
   bool write_masks = true;
   // Maximum number of sparse points3D (each seen in >= 2 views). [0, 1e7].
@@ -78,7 +82,8 @@ SynthesizerSummary SynthesizeWorkspace(const SynthesizerOptions& options);
 // Name of view i: "view_0000.png", ...
 std::string SynthViewName(int i);
 
-// Writes an 8-bit grayscale-as-RGB PNG of `image` (radiance * 255).
+// Writes an 8-bit RGB PNG of `image` (radiance * 255, rounded; grey styles
+// give R = G = B).
 void WriteSynthImagePng(const std::string& path, const SynthImage& image);
 
 }  // namespace mr

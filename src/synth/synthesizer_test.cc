@@ -6,10 +6,13 @@
 #include <cmath>
 #include <filesystem>
 #include <fstream>
+#include <functional>
 #include <string>
 #include <vector>
 
 #include <gtest/gtest.h>
+#include <opencv2/core.hpp>
+#include <opencv2/imgcodecs.hpp>
 
 #include "colmap_io/dense_array.h"
 #include "colmap_io/ply.h"
@@ -62,6 +65,56 @@ TEST(SynthesizerOptions, RejectsBadValues) {
   options.shape = "builtin";
   options.colmap.poisson_trim = -1;
   EXPECT_THROW(options.Check(), InputError);
+}
+
+// The options behind the flags --texture_style, --light, --image_noise,
+// --texture_contrast, --ambient, --focal_factor, --min/max_elevation_deg.
+TEST(SynthesizerOptions, RejectsBadImageStyleAndCameraValues) {
+  SynthesizerOptions base;
+  base.output_path = "/tmp/x";
+  const auto rejects = [&](const std::function<void(SynthesizerOptions*)>& set) {
+    SynthesizerOptions options = base;
+    set(&options);
+    try {
+      options.Check();
+    } catch (const InputError& e) {
+      return std::string(e.what());
+    }
+    return std::string("accepted");
+  };
+  const auto expect_message = [](const std::string& what, const std::string& field) {
+    EXPECT_NE(what.find(field), std::string::npos) << what;
+    EXPECT_NE(what.find("Violated constraint"), std::string::npos) << what;
+  };
+  expect_message(rejects([](SynthesizerOptions* o) { o->appearance.texture_style = "marble"; }),
+                 "texture_style = marble");
+  expect_message(rejects([](SynthesizerOptions* o) { o->appearance.light = "sun"; }),
+                 "light = sun");
+  for (const double v : {-0.01, 0.6, std::nan("")}) {
+    expect_message(rejects([v](SynthesizerOptions* o) { o->image_noise = v; }), "image_noise");
+  }
+  expect_message(rejects([](SynthesizerOptions* o) { o->appearance.texture_contrast = 0; }),
+                 "texture_contrast");
+  expect_message(rejects([](SynthesizerOptions* o) { o->appearance.ambient = 1.2; }), "ambient");
+  expect_message(rejects([](SynthesizerOptions* o) { o->cameras.focal_factor = 0.05; }),
+                 "focal_factor");
+  expect_message(rejects([](SynthesizerOptions* o) { o->cameras.focal_factor = 11; }),
+                 "focal_factor");
+  expect_message(rejects([](SynthesizerOptions* o) { o->cameras.min_elevation_deg = 80; }),
+                 "min_elevation_deg");
+  expect_message(rejects([](SynthesizerOptions* o) { o->cameras.max_elevation_deg = 90; }),
+                 "max_elevation_deg");
+  expect_message(rejects([](SynthesizerOptions* o) { o->cameras.min_elevation_deg = -90; }),
+                 "min_elevation_deg");
+  // And good values pass.
+  EXPECT_EQ(rejects([](SynthesizerOptions* o) {
+              o->appearance.texture_style = "none";
+              o->appearance.light = "headlight";
+              o->image_noise = 0.5;
+              o->cameras.focal_factor = 2;
+              o->cameras.min_elevation_deg = -30;
+            }),
+            "accepted");
 }
 
 TEST(Synthesizer, WritesWorkspaceAndGroundTruthBesideIt) {
@@ -147,6 +200,108 @@ TEST(Synthesizer, WritesWorkspaceAndGroundTruthBesideIt) {
   }
   ASSERT_GT(n, 300);
   EXPECT_GT(close, 0.97 * n);
+}
+
+cv::Mat ReadPng(const std::string& path) {
+  const cv::Mat image = cv::imread(path, cv::IMREAD_UNCHANGED);
+  EXPECT_FALSE(image.empty()) << path;
+  EXPECT_EQ(image.type(), CV_8UC3) << path;
+  return image;
+}
+
+// --image_noise reaches the written images at the requested level (pixels
+// that it could have clipped ignored) and nothing else; the default images
+// are grey (R = G = B) and so are the point colours.
+TEST(Synthesizer, ImageNoiseReachesTheWrittenImagesOnly) {
+  const std::string dir = FreshDir("image_noise");
+  SynthesizerOptions clean_options = SmallOptions(JoinPaths(dir, "clean"));
+  SynthesizerOptions noisy_options = SmallOptions(JoinPaths(dir, "noisy"));
+  const double sigma = 0.03;
+  noisy_options.image_noise = sigma;
+  SynthesizeWorkspace(clean_options);
+  SynthesizeWorkspace(noisy_options);
+  const std::string clean = JoinPaths(clean_options.output_path, "dense");
+  const std::string noisy = JoinPaths(noisy_options.output_path, "dense");
+  double sum = 0, sum2 = 0;
+  long n = 0;
+  for (int i = 0; i < 6; ++i) {
+    const std::string name = SynthViewName(i);
+    const cv::Mat a = ReadPng(JoinPaths(clean, "images/" + name));
+    const cv::Mat b = ReadPng(JoinPaths(noisy, "images/" + name));
+    for (int row = 0; row < a.rows; ++row) {
+      for (int col = 0; col < a.cols; ++col) {
+        const cv::Vec3b pa = a.at<cv::Vec3b>(row, col), pb = b.at<cv::Vec3b>(row, col);
+        ASSERT_TRUE(pa[0] == pa[1] && pa[1] == pa[2]) << "grey expected";
+        for (int c = 0; c < 3; ++c) {
+          const double va = pa[c] / 255.0, vb = pb[c] / 255.0;
+          if (va < 4 * sigma || va > 1 - 4 * sigma) continue;
+          sum += vb - va;
+          sum2 += (vb - va) * (vb - va);
+          ++n;
+        }
+      }
+    }
+    EXPECT_EQ(ReadFileToString(JoinPaths(clean, "stereo/depth_maps/" + name + ".geometric.bin")),
+              ReadFileToString(JoinPaths(noisy, "stereo/depth_maps/" + name + ".geometric.bin")));
+    EXPECT_EQ(ReadFileToString(JoinPaths(clean, "masks/" + name + ".png")),
+              ReadFileToString(JoinPaths(noisy, "masks/" + name + ".png")));
+  }
+  ASSERT_GT(n, 20000);
+  const double mean = sum / n, sd = std::sqrt(sum2 / n - mean * mean);
+  EXPECT_NEAR(sd, sigma, 0.1 * sigma);
+  EXPECT_NEAR(mean, 0, 0.1 * sigma);
+  const Reconstruction model = ReadSparseModelBinary(JoinPaths(clean, "sparse"));
+  ASSERT_FALSE(model.points3D.empty());
+  for (const auto& [id, point] : model.points3D) {
+    ASSERT_TRUE(point.rgb(0) == point.rgb(1) && point.rgb(1) == point.rgb(2));
+  }
+}
+
+// smooth_color writes colour PNGs (in RGB order: the point colours, taken
+// from the rendered radiance, match the pixels read back) under a headlight.
+TEST(Synthesizer, SmoothColorWritesColourImagesAndPointColours) {
+  const std::string dir = FreshDir("smooth_color");
+  SynthesizerOptions options = SmallOptions(dir);
+  options.appearance.texture_style = "smooth_color";
+  options.appearance.light = "headlight";
+  SynthesizeWorkspace(options);
+  const std::string dense = JoinPaths(dir, "dense");
+  std::vector<cv::Mat> images;
+  for (int i = 0; i < 6; ++i) {
+    images.push_back(ReadPng(JoinPaths(dense, "images/" + SynthViewName(i))));
+  }
+  int coloured = 0, object = 0;
+  for (int row = 0; row < images[0].rows; ++row) {
+    for (int col = 0; col < images[0].cols; ++col) {
+      const cv::Vec3b p = images[0].at<cv::Vec3b>(row, col);
+      if (p[0] + p[1] + p[2] == 0) continue;
+      ++object;
+      if (std::max({std::abs(p[0] - p[1]), std::abs(p[1] - p[2]), std::abs(p[0] - p[2])}) > 20) {
+        ++coloured;
+      }
+    }
+  }
+  ASSERT_GT(object, 1000);
+  EXPECT_GT(coloured, 0.3 * object);
+  const Reconstruction model = ReadSparseModelBinary(JoinPaths(dense, "sparse"));
+  ASSERT_GT(model.points3D.size(), 100u);
+  int coloured_points = 0;
+  double max_error = 0;
+  for (const auto& [id, point] : model.points3D) {
+    Eigen::Vector3d mean = Eigen::Vector3d::Zero();
+    for (const TrackElement& el : point.track) {
+      const Image& image = model.images.at(el.image_id);
+      const Eigen::Vector2d xy = image.points2D[el.point2D_idx].xy;
+      const cv::Vec3b bgr = images[el.image_id - 1].at<cv::Vec3b>(static_cast<int>(xy.y()),
+                                                                  static_cast<int>(xy.x()));
+      mean += Eigen::Vector3d(bgr[2], bgr[1], bgr[0]) / point.track.size();
+    }
+    // rgb truncates the mean radiance, the PNG rounds each pixel.
+    max_error = std::max(max_error, (point.rgb.cast<double>() - mean).cwiseAbs().maxCoeff());
+    if (std::abs(int(point.rgb(0)) - int(point.rgb(2))) > 20) ++coloured_points;
+  }
+  EXPECT_LT(max_error, 1.5);
+  EXPECT_GT(coloured_points, 0.2 * model.points3D.size());
 }
 
 TEST(Synthesizer, ExistingWorkspaceIsRejected) {

@@ -41,9 +41,79 @@ double Grad(uint32_t h, double x, double y, double z) {
 double Fade(double t) { return t * t * t * (t * (t * 6 - 15) + 10); }
 double Lerp(double a, double b, double t) { return a + t * (b - a); }
 
+// Luminance weights (BT.601, as OpenCV's colour-to-grey conversion).
+const Eigen::Vector3d kLuminanceWeights(0.299, 0.587, 0.114);
+
+// "contrast": 4 octaves from 8x down to 1x texture_scale, the fine ones
+// weighted nearly as much as the coarse ones so that there is contrast at the
+// scale of a few pixels. Octaves are shifted to decorrelate them.
+double ContrastAlbedo(const AppearanceOptions& options, const Eigen::Vector3d& p) {
+  double sum = 0, norm = 0, period = 8 * options.texture_scale, weight = 1;
+  for (int octave = 0; octave < 4; ++octave) {
+    const Eigen::Vector3d shift(17.3 * octave, -5.1 * octave, 9.7 * octave);
+    sum += weight * GradientNoise(p / period + shift);
+    norm += weight;
+    period *= 0.5;
+    weight *= 0.8;
+  }
+  const double n = sum / norm;  // ~[-0.5, 0.5] typically
+  const double t = 0.5 + 0.5 * std::tanh(options.texture_contrast * 2 * n);
+  return options.min_albedo + (options.max_albedo - options.min_albedo) * t;
+}
+
+// A smooth field of periods 16x and 8x texture_scale, in [-1, 1] (standard
+// deviation ~0.2); `shift` decorrelates fields.
+double SmoothField(const AppearanceOptions& options, const Eigen::Vector3d& p,
+                   const Eigen::Vector3d& shift) {
+  const double period = 16 * options.texture_scale;
+  const double coarse = GradientNoise(p / period + shift);
+  const double fine = GradientNoise(2 * p / period + shift + Eigen::Vector3d(31.7, 7.3, -12.9));
+  return std::clamp((coarse + 0.6 * fine) / 1.6, -1.0, 1.0);
+}
+
+// "smooth_color": luminance within 10% of the middle of the albedo range, a
+// chroma vector with no luminance (red-green and blue-yellow axes) scaled by
+// two smooth fields, shortened where a channel would leave the albedo range.
+Eigen::Vector3d SmoothColorAlbedo(const AppearanceOptions& options, const Eigen::Vector3d& p) {
+  // Chroma axes: (1, -1, 0) and (-0.5, -0.5, 1) minus their luminance.
+  static const Eigen::Vector3d kRedGreen =
+      Eigen::Vector3d(1, -1, 0) - kLuminanceWeights.dot(Eigen::Vector3d(1, -1, 0)) *
+                                      Eigen::Vector3d::Ones();
+  static const Eigen::Vector3d kBlueYellow =
+      Eigen::Vector3d(-0.5, -0.5, 1) - kLuminanceWeights.dot(Eigen::Vector3d(-0.5, -0.5, 1)) *
+                                           Eigen::Vector3d::Ones();
+  constexpr double kChromaGain = 0.6;
+  const double lo = options.min_albedo, hi = options.max_albedo;
+  const double mid = 0.5 * (lo + hi);
+  const double luminance = std::clamp(
+      mid * (1 + 0.1 * SmoothField(options, p, Eigen::Vector3d(-41.3, 23.9, 5.5))), lo, hi);
+  const Eigen::Vector3d chroma =
+      kChromaGain * (SmoothField(options, p, Eigen::Vector3d(3.7, 61.1, -27.4)) * kRedGreen +
+                     SmoothField(options, p, Eigen::Vector3d(-19.9, -8.3, 44.6)) * kBlueYellow);
+  double t = 1;  // largest t <= 1 with luminance + t * chroma inside [lo, hi]
+  for (int c = 0; c < 3; ++c) {
+    if (chroma(c) > 0) t = std::min(t, (hi - luminance) / chroma(c));
+    if (chroma(c) < 0) t = std::min(t, (lo - luminance) / chroma(c));
+  }
+  return luminance * Eigen::Vector3d::Ones() + std::max(0.0, t) * chroma;
+}
+
+// "none": the middle of the albedo range, +-2% at periods >= 16x texture_scale.
+double UniformAlbedo(const AppearanceOptions& options, const Eigen::Vector3d& p) {
+  const double mid = 0.5 * (options.min_albedo + options.max_albedo);
+  const double n = std::clamp(
+      GradientNoise(p / (16 * options.texture_scale) + Eigen::Vector3d(7.1, -3.3, 12.7)), -1.0,
+      1.0);
+  return std::clamp(mid * (1 + 0.02 * n), options.min_albedo, options.max_albedo);
+}
+
 }  // namespace
 
 bool AppearanceOptions::Check() const {
+  if (texture_style != "contrast" && texture_style != "smooth_color" && texture_style != "none") {
+    MR_THROW_INPUT << "AppearanceOptions::texture_style = " << texture_style
+                   << ". Violated constraint: texture_style is contrast, smooth_color or none";
+  }
   if (!(texture_scale > 0 && texture_scale <= 1000)) {
     MR_THROW_INPUT << "AppearanceOptions::texture_scale = " << texture_scale
                    << ". Violated constraint: 0 < texture_scale <= 1000";
@@ -59,6 +129,10 @@ bool AppearanceOptions::Check() const {
   if (!(ambient >= 0 && ambient <= 1)) {
     MR_THROW_INPUT << "AppearanceOptions::ambient = " << ambient
                    << ". Violated constraint: 0 <= ambient <= 1";
+  }
+  if (light != "world" && light != "headlight") {
+    MR_THROW_INPUT << "AppearanceOptions::light = " << light
+                   << ". Violated constraint: light is world or headlight";
   }
   if (!(light_direction.norm() > 0) || !light_direction.allFinite()) {
     MR_THROW_INPUT << "AppearanceOptions::light_direction = (" << light_direction.transpose()
@@ -84,26 +158,19 @@ double GradientNoise(const Eigen::Vector3d& p) {
               Lerp(Lerp(n001, n101, u), Lerp(n011, n111, u), v), w);
 }
 
-double Albedo(const AppearanceOptions& options, const Eigen::Vector3d& p) {
-  // Four octaves from 8x down to 1x texture_scale, the fine ones weighted
-  // nearly as much as the coarse ones so that there is contrast at the scale
-  // of a few pixels. Octaves are shifted to decorrelate them.
-  double sum = 0, norm = 0, period = 8 * options.texture_scale, weight = 1;
-  for (int octave = 0; octave < 4; ++octave) {
-    const Eigen::Vector3d shift(17.3 * octave, -5.1 * octave, 9.7 * octave);
-    sum += weight * GradientNoise(p / period + shift);
-    norm += weight;
-    period *= 0.5;
-    weight *= 0.8;
-  }
-  const double n = sum / norm;  // ~[-0.5, 0.5] typically
-  const double t = 0.5 + 0.5 * std::tanh(options.texture_contrast * 2 * n);
-  return options.min_albedo + (options.max_albedo - options.min_albedo) * t;
+double Luminance(const Eigen::Vector3d& rgb) { return kLuminanceWeights.dot(rgb); }
+
+Eigen::Vector3d Albedo(const AppearanceOptions& options, const Eigen::Vector3d& p) {
+  if (options.texture_style == "smooth_color") return SmoothColorAlbedo(options, p);
+  if (options.texture_style == "none") return Eigen::Vector3d::Constant(UniformAlbedo(options, p));
+  return Eigen::Vector3d::Constant(ContrastAlbedo(options, p));
 }
 
-double ShadePoint(const AppearanceOptions& options, const Eigen::Vector3d& p,
-                  const Eigen::Vector3d& n) {
-  const Eigen::Vector3d light = options.light_direction.normalized();
+Eigen::Vector3d ShadePoint(const AppearanceOptions& options, const Eigen::Vector3d& p,
+                           const Eigen::Vector3d& n, const Eigen::Vector3d& eye) {
+  const Eigen::Vector3d light = options.light == "headlight"
+                                    ? (eye - p).normalized()
+                                    : options.light_direction.normalized();
   const double lambert = std::max(0.0, n.dot(light));
   return Albedo(options, p) * (options.ambient + (1 - options.ambient) * lambert);
 }
