@@ -1,0 +1,79 @@
+#!/usr/bin/env bash
+# mesh_refiner on the development corpus (benchmark/refine/corpus.txt): for
+# each case, workspace_synthesizer (real colmap stereo_fusion +
+# poisson_mesher), then mesh_refiner in each configuration, then
+# mesh_evaluator on the observed surface (ground-truth faces seen by >= 2
+# cameras). Prints one row per case and configuration, with the ratios to the
+# Poisson input and the issue's floors (accuracy90 <= 0.6x, normal error <=
+# 0.7x, completeness no more than 1 point lower), then the worst case of each
+# column per configuration. Workspaces and results in OUT_DIR are reused
+# (delete a case's folder, or its OUT_DIR/<case>.<config>.* files, to redo).
+#
+#   bash benchmark/refine/run_corpus.sh OUT_DIR [case ...]
+#
+# Configurations: "defaults" (no flag) and the isotropic baseline
+# "zncc+laplacian"; CONFIGS adds more, one "label|flags" per line, e.g.
+#   CONFIGS='lp|--Refine.regularizer lp' bash benchmark/refine/run_corpus.sh /tmp/corpus
+# BASELINE=0 leaves the baseline out, DEFAULTS=0 the defaults; BIN points
+# at another build's bin/.
+set -euo pipefail
+cd "$(dirname "$0")/../.."
+OUT=${1:?usage: run_corpus.sh OUT_DIR [case ...]}
+shift || true
+OUT=$(realpath -m "$OUT")
+BIN=${BIN:-$PWD/build/bin}
+MODELS=$(realpath ../shared/data/models)
+CORPUS=benchmark/refine/corpus.txt
+export QT_QPA_PLATFORM=offscreen
+mkdir -p "$OUT"
+
+configs=""
+if [ "${DEFAULTS:-1}" != 0 ]; then configs+="defaults|"$'\n'; fi
+if [ "${BASELINE:-1}" != 0 ]; then
+  configs+="zncc+laplacian|--Refine.similarity zncc --Refine.regularizer laplacian"$'\n'
+fi
+if [ -n "${CONFIGS:-}" ]; then configs+=$'\n'"$CONFIGS"; fi
+
+cases=$(grep -v '^#' "$CORPUS" | grep -v '^\s*$' | cut -d'|' -f1 | tr -d ' ')
+if [ $# -gt 0 ]; then cases="$*"; fi
+
+evaluate() {  # case mesh -> json on stdout
+  "$BIN/mesh_evaluator" --input_path "$2" --gt_path "$OUT/$1/ground_truth.ply" \
+    --workspace_path "$OUT/$1/dense"
+}
+
+TSV="$OUT/results.tsv"
+: > "$TSV"
+for name in $cases; do
+  line=$(grep -E "^$name\s*\|" "$CORPUS") || { echo "unknown case: $name" >&2; exit 2; }
+  flags=$(echo "${line#*|}" | sed "s#--model_path #--model_path $MODELS/#")
+  ws="$OUT/$name"
+  if [ ! -f "$ws/dense/meshed-poisson.ply" ]; then
+    rm -rf "$ws"
+    echo "[$(date +%T)] synthesising $name" >&2
+    # shellcheck disable=SC2086
+    "$BIN/workspace_synthesizer" --output_path "$ws" $flags > "$OUT/$name.synth.log" 2>&1
+  fi
+  if [ ! -f "$OUT/$name.input.json" ]; then
+    evaluate "$name" "$ws/dense/meshed-poisson.ply" > "$OUT/$name.input.json"
+  fi
+  printf '%s\tinput\t%s\t0\t0\n' "$name" "$(cat "$OUT/$name.input.json")" >> "$TSV"
+  while IFS= read -r config; do
+    [ -z "$config" ] && continue
+    label=${config%%|*}
+    rflags=${config#*|}
+    out="$ws/dense/meshed-refined-${label//[^A-Za-z0-9_.-]/_}.ply"
+    stem="$OUT/$name.${label//[^A-Za-z0-9_.-]/_}"
+    if [ ! -f "$stem.json" ]; then
+      echo "[$(date +%T)] $name: $label" >&2
+      # shellcheck disable=SC2086
+      /usr/bin/time -f "%e %M" -o "$stem.time" "$BIN/mesh_refiner" --workspace_path "$ws/dense" \
+        --output_path "$out" $rflags > "$stem.log" 2>&1 || {
+          echo "mesh_refiner failed on $name ($label): see $stem.log" >&2; continue; }
+      evaluate "$name" "$out" > "$stem.json"
+    fi
+    read -r secs kb < "$stem.time"
+    printf '%s\t%s\t%s\t%s\t%s\n' "$name" "$label" "$(cat "$stem.json")" "$secs" "$((kb / 1024))" >> "$TSV"
+  done <<< "$configs"
+done
+python3 benchmark/refine/corpus_table.py "$TSV" | tee "$OUT/results.md"
