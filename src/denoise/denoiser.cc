@@ -45,7 +45,7 @@ double RobustSigma(const Eigen::MatrixXd& R, const Eigen::MatrixXd& W) {
 }
 
 void DenoiseLp(const Eigen::MatrixXd& V0, const Eigen::MatrixXi& F, const DenoiseOptions& o,
-               DenoiseResult* result) {
+               const Eigen::MatrixXd* noise_reference, DenoiseResult* result) {
   const double t0 = Now();
   const int n = static_cast<int>(V0.rows());
   EdgeQuads eq = BuildEdgeQuads(F, n);
@@ -82,7 +82,12 @@ void DenoiseLp(const Eigen::MatrixXd& V0, const Eigen::MatrixXi& F, const Denois
   if (direct) solver.Analyze(normal.Matrix(1.0));
   result->setup_seconds = Now() - t0;
 
-  const double sigma0 = RobustSigma(ApplyEdgeOperator(eq.quads, W, X0), W);
+  // The noise to remove: all of X0's roughness, or only what was added to
+  // the reference (D is linear in X for fixed weights).
+  const double sigma0 =
+      noise_reference == nullptr
+          ? RobustSigma(ApplyEdgeOperator(eq.quads, W, X0), W)
+          : RobustSigma(ApplyEdgeOperator(eq.quads, W, (V0 - *noise_reference) / h), W);
   Eigen::VectorXd row_scale = Eigen::VectorXd::Ones(eq.quads.rows());
   for (int k = 0; k < o.max_iterations; ++k) {
     const double tk = Now();
@@ -280,7 +285,7 @@ std::string DenoiseResult::BriefReport() const {
 }
 
 DenoiseResult Denoise(const Eigen::MatrixXd& V0, const Eigen::MatrixXi& F,
-                      const DenoiseOptions& options) {
+                      const DenoiseOptions& options, const Eigen::MatrixXd* noise_reference) {
   options.Check();
   const double t0 = Now();
   if (V0.rows() > 0 && V0.cols() != 3) {
@@ -301,7 +306,11 @@ DenoiseResult Denoise(const Eigen::MatrixXd& V0, const Eigen::MatrixXi& F,
   DenoiseResult result;
   result.method = options.method;
   if (options.method == "lp") {
-    DenoiseLp(V0, F, options, &result);
+    if (noise_reference != nullptr) {
+      MR_CHECK(noise_reference->rows() == V0.rows() && noise_reference->cols() == 3)
+          << "noise_reference must be #V by 3";
+    }
+    DenoiseLp(V0, F, options, noise_reference, &result);
   } else if (options.method == "l0") {
     DenoiseL0(V0, F, options, &result);
   } else if (options.method == "laplacian") {

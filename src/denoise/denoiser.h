@@ -194,8 +194,15 @@ struct DenoiseResult {
 // Denoises the mesh (V0 #V by 3, F #F by 3). Throws mr::InputError on bad
 // options, out-of-range indices or non-finite coordinates. A mesh with no
 // interior edge (empty, one triangle) is passed through unchanged.
+//
+// lp only: `noise_reference` (optional, #V by 3) is the mesh before the
+// operation that made V0 noisy, for instance a refiner's gradient step. The
+// noise sigma of the first round is then estimated from D (V0 - reference),
+// the roughness that operation added, instead of from D V0, which also counts
+// the surface's own relief and would smooth it away.
 DenoiseResult Denoise(const Eigen::MatrixXd& V0, const Eigen::MatrixXi& F,
-                      const DenoiseOptions& options);
+                      const DenoiseOptions& options,
+                      const Eigen::MatrixXd* noise_reference = nullptr);
 
 // Registers every DenoiseOptions field as `--<section>.<field>` (e.g.
 // `--Denoise.method lp`); used by mesh_denoiser and mesh_refiner.
