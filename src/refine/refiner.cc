@@ -9,12 +9,14 @@
 #include <sstream>
 
 #include <opencv2/imgproc.hpp>
+#include <opencv2/video/tracking.hpp>
 
 #include "eval/evaluator.h"
 #include "geometry/mesh.h"
 #include "geometry/remesh.h"
 #include "refine/pyramid.h"
 #include "refine/silhouette.h"
+#include "refine/step_filter.h"
 #include "render/renderer.h"
 #include "util/error.h"
 #include "util/logging.h"
@@ -182,6 +184,117 @@ void SampleVertexColors(const ViewSource& source, const Eigen::MatrixXd& V,
   }
 }
 
+struct Schedule {
+  int num_levels = 1;
+  double misalignment_px = 0;  // median image misalignment of the input
+  double initial_similarity = 0;
+  std::string reason;
+};
+
+// How far the input surface is from the images, in full-resolution pixels:
+// for each view pair (i, j), the image predicted for view i through the mesh
+// (image j warped by the surface) is compared with image i by dense optical
+// flow (Farneback); a surface that is off by d pixels shifts the prediction
+// by about d. Only pixels where the prediction is valid and image i has more
+// than its median gradient count (textureless pixels carry no flow). The
+// median over the pixels of each pair, then the median over pairs.
+double MeasureMisalignmentPx(const std::vector<PinholeView>& views,
+                             const std::vector<std::pair<int, int>>& pairs,
+                             const MeshGeometry& geometry, const PairTermOptions& pair_options,
+                             RenderCache* renders, ImageCache* images) {
+  std::vector<double> per_pair;
+  for (const auto& [i, j] : pairs) {
+    const auto render_i = renders->Get(i);
+    const auto render_j = renders->Get(j);
+    cv::Mat predicted, mask;
+    PredictImage(geometry, views[i], *render_i, views[j], *render_j, images->Gray(j, 0),
+                 pair_options, &predicted, &mask);
+    const cv::Mat image_i = images->Gray(i, 0);
+    cv::Mat erode;
+    cv::erode(mask, erode, cv::getStructuringElement(cv::MORPH_ELLIPSE, cv::Size(9, 9)));
+    if (cv::countNonZero(erode) < 500) continue;
+    cv::Mat a8, b8, predicted32;
+    predicted.convertTo(predicted32, CV_32F);
+    image_i.copyTo(predicted32, mask == 0);  // no flow where nothing is predicted
+    image_i.convertTo(a8, CV_8U, 255.0);
+    predicted32.convertTo(b8, CV_8U, 255.0);
+    cv::Mat flow;
+    cv::calcOpticalFlowFarneback(a8, b8, flow, 0.5, 5, 15, 3, 5, 1.1, 0);
+    cv::Mat gx, gy;
+    cv::Sobel(image_i, gx, CV_32F, 1, 0);
+    cv::Sobel(image_i, gy, CV_32F, 0, 1);
+    std::vector<float> gradients;
+    for (int r = 0; r < erode.rows; ++r) {
+      for (int c = 0; c < erode.cols; ++c) {
+        if (erode.at<uint8_t>(r, c)) gradients.push_back(std::hypot(gx.at<float>(r, c), gy.at<float>(r, c)));
+      }
+    }
+    std::nth_element(gradients.begin(), gradients.begin() + gradients.size() / 2, gradients.end());
+    const float gradient_median = gradients[gradients.size() / 2];
+    std::vector<float> shifts;
+    for (int r = 0; r < erode.rows; ++r) {
+      for (int c = 0; c < erode.cols; ++c) {
+        if (!erode.at<uint8_t>(r, c) ||
+            std::hypot(gx.at<float>(r, c), gy.at<float>(r, c)) <= gradient_median) {
+          continue;
+        }
+        const cv::Vec2f f = flow.at<cv::Vec2f>(r, c);
+        shifts.push_back(std::hypot(f[0], f[1]));
+      }
+    }
+    if (shifts.empty()) continue;
+    std::nth_element(shifts.begin(), shifts.begin() + shifts.size() / 2, shifts.end());
+    per_pair.push_back(shifts[shifts.size() / 2]);
+  }
+  if (per_pair.empty()) return 0;
+  std::nth_element(per_pair.begin(), per_pair.begin() + per_pair.size() / 2, per_pair.end());
+  return per_pair[per_pair.size() / 2];
+}
+
+// Picks the number of pyramid levels from the input itself: its misalignment
+// with the images in full-resolution pixels, d (MeasureMisalignmentPx). The
+// gradient flow converges from within about a pixel of the optimum at its
+// level, and level l divides the misalignment by 2^l, so the refinement
+// starts at the coarsest level needed to bring d under
+// schedule_misalignment_px, within the levels whose images keep
+// min_level_image_px on their short side. A Poisson mesh is typically within
+// a pixel (1 level, no decimation); a visual hull is several pixels off.
+Schedule ChooseNumLevels(const ViewSource& source, const std::vector<std::pair<int, int>>& pairs,
+                         const RefineOptions& options, const Eigen::MatrixXd& V,
+                         const Eigen::MatrixXi& F, Renderer* renderer, size_t cache_bytes,
+                         ImageCache* images) {
+  Schedule schedule;
+  const std::vector<PinholeView> views = source.Views();
+  renderer->SetMesh(V, F);
+  const MeshGeometry geometry{&V, &F, FaceNormals(V, F)};
+  RenderCache renders(renderer, views, cache_bytes);
+  schedule.misalignment_px =
+      MeasureMisalignmentPx(views, pairs, geometry, options.pair, &renders, images);
+  int max_levels = 1;
+  while (max_levels < 6) {
+    const PinholeView coarse = PyramidLevelView(views[0], max_levels);
+    if (std::min(coarse.width, coarse.height) < options.min_level_image_px) break;
+    ++max_levels;
+  }
+  int levels = 1;
+  while (levels < max_levels &&
+         schedule.misalignment_px / std::pow(2.0, levels - 1) > options.schedule_misalignment_px) {
+    ++levels;
+  }
+  schedule.num_levels = levels;
+  std::ostringstream reason;
+  reason << levels << (levels == 1 ? " level" : " levels") << ": the input is "
+         << std::setprecision(2) << schedule.misalignment_px
+         << " px off the images (median optical flow between each image and its prediction "
+            "through the mesh); "
+         << (levels == 1 ? "within " : "above ") << options.schedule_misalignment_px << " px"
+         << (levels == 1 ? ": a close start, full resolution only"
+                         : ": a far-off start, coarse to fine");
+  if (levels == max_levels && levels > 1) reason << " (the most levels the image size allows)";
+  schedule.reason = reason.str();
+  return schedule;
+}
+
 std::string FormatSeconds(double s) {
   std::ostringstream out;
   out << std::fixed << std::setprecision(1) << s << " s";
@@ -195,7 +308,10 @@ bool RefineOptions::Check() const {
     MR_THROW_INPUT << "RefineOptions::" << field << " = " << value
                    << ". Violated constraint: " << bound;
   };
-  if (num_levels < 1 || num_levels > 6) fail("num_levels", std::to_string(num_levels), "1 <= num_levels <= 6");
+  if (num_levels < 0 || num_levels > 6) fail("num_levels", std::to_string(num_levels), "0 <= num_levels <= 6 (0: chosen from the input)");
+  if (!(min_improvement >= 0)) fail("min_improvement", std::to_string(min_improvement), "min_improvement >= 0");
+  if (!(schedule_misalignment_px > 0)) fail("schedule_misalignment_px", std::to_string(schedule_misalignment_px), "schedule_misalignment_px > 0");
+  if (min_level_image_px < 16) fail("min_level_image_px", std::to_string(min_level_image_px), "min_level_image_px >= 16");
   if (iterations_per_level < 0) fail("iterations_per_level", std::to_string(iterations_per_level), "iterations_per_level >= 0");
   if (!(target_edge_px > 0)) fail("target_edge_px", std::to_string(target_edge_px), "target_edge_px > 0");
   if (max_faces < 0) fail("max_faces", std::to_string(max_faces), "max_faces >= 0");
@@ -227,6 +343,7 @@ std::string RefineSummary::BriefReport() const {
 std::string RefineSummary::FullReport() const {
   std::ostringstream out;
   out << BriefReport() << "\n";
+  if (!schedule.empty()) out << "  schedule: " << schedule << "\n";
   out << "  views " << num_views << ", pairs " << num_pairs << ", vertices " << initial_vertices
       << " -> " << final_vertices << ", flipped faces fixed " << flipped_faces_fixed
       << ", intersecting pairs undone " << self_intersections_undone << " (" << vertices_reset
@@ -303,21 +420,30 @@ RefineSummary RefineMesh(const ViewSource& source, const RefineOptions& options,
   DenoiseOptions denoise = options.denoise;
   denoise.method = options.regularizer == "laplacian" ? "laplacian" : "lp";
 
+  // The schedule: how many pyramid levels, from the input's similarity at
+  // each level (ChooseNumLevels), unless num_levels is given.
+  int num_levels = options.num_levels;
+  if (num_levels == 0) {
+    const Schedule schedule = ChooseNumLevels(source, pairs, options, V, F, renderer,
+                                              cache_bytes / 2, &images);
+    num_levels = schedule.num_levels;
+    summary.schedule = schedule.reason;
+    MR_LOG(INFO) << "Schedule: " << schedule.reason;
+  }
   // With one level the first iteration measures the same thing (plain ZNCC
   // of all pairs at full resolution; κ does not enter m) on the input
   // remeshed to the working resolution, so it is taken from there.
-  const bool initial_from_first_iteration =
-      options.num_levels == 1 && options.iterations_per_level > 0;
+  const bool initial_from_first_iteration = num_levels == 1 && options.iterations_per_level > 0;
   if (!initial_from_first_iteration) {
     summary.initial_similarity = FullResolutionSimilarity(
         source, pairs, similarity, options.pair, V, F, renderer, cache_bytes / 2, &images);
     MR_LOG(INFO) << "Initial mean similarity (ZNCC, full resolution): "
                  << summary.initial_similarity;
   }
-  const int total_iterations = options.num_levels * options.iterations_per_level;
+  const int total_iterations = num_levels * options.iterations_per_level;
   int global_iteration = 0;
   bool guard_verified_clean = false;  // the last iteration's guard found no intersection
-  for (int level = options.num_levels - 1; level >= 0; --level) {
+  for (int level = num_levels - 1; level >= 0; --level) {
     const std::vector<PinholeView> views = ScaledViews(source, level);
     RemeshForLevel(views, options, max_faces, &V, &F);
     guard_verified_clean = false;
@@ -366,21 +492,51 @@ RefineSummary RefineMesh(const ViewSource& source, const RefineOptions& options,
                           "not visible in overlapping views";
       }
 
-      // Gauss-Newton step down the reprojection error, clamped to max_step_px
-      // footprints.
+      // Gauss-Newton step down the reprojection error (filtered by the data
+      // confidence when filter_step is on), clamped to max_step_px footprints.
       const double mu = options.damping * MedianPositive(term.curvature);
+      Eigen::VectorXd confidence = Eigen::VectorXd::Zero(V.rows());
+      for (int v = 0; v < V.rows(); ++v) {
+        if (term.weight(v) > 0 && term.curvature(v) + mu > 0) confidence(v) = term.curvature(v) + mu;
+      }
       Eigen::MatrixXd step = Eigen::MatrixXd::Zero(V.rows(), 3);
+      if (options.filter_step) {
+        StepFilterSummary filtered;
+        step = FilterStep(options.step * term.gradient, confidence, F, options.step_filter,
+                          &filtered);
+        std::ostringstream report;
+        report << "step filter w=" << filtered.edge_weight << " jitter "
+               << filtered.jitter_before << "->" << filtered.jitter_after << " (cg "
+               << filtered.cg_iterations << ")";
+        record.step_filter_report = report.str();
+      } else {
+        for (int v = 0; v < V.rows(); ++v) {
+          if (confidence(v) > 0) step.row(v) = -options.step * term.gradient.row(v) / confidence(v);
+        }
+      }
+      double mean_footprint = 0;
+      {
+        double sum = 0;
+        long count = 0;
+        for (int v = 0; v < V.rows(); ++v) {
+          if (term.weight(v) > 0) {
+            sum += term.footprint(v) / term.weight(v);
+            ++count;
+          }
+        }
+        mean_footprint = count > 0 ? sum / count : 0;
+      }
       double step_sum = 0, step_max = 0;
       long num_moved = 0;
       for (int v = 0; v < V.rows(); ++v) {
-        if (!(term.weight(v) > 0) || !(term.curvature(v) + mu > 0)) continue;
-        Eigen::Vector3d d = -options.step * term.gradient.row(v) / (term.curvature(v) + mu);
-        const double footprint = term.footprint(v) / term.weight(v);
+        const double norm = step.row(v).norm();
+        if (!(norm > 0)) continue;
+        const double footprint =
+            term.weight(v) > 0 ? term.footprint(v) / term.weight(v) : mean_footprint;
         const double limit = options.max_step_px * footprint;
-        if (d.norm() > limit) d *= limit / d.norm();
-        step.row(v) = d.transpose();
-        step_sum += d.norm() / footprint;
-        step_max = std::max(step_max, d.norm() / footprint);
+        if (norm > limit) step.row(v) *= limit / norm;
+        step_sum += std::min(norm, limit) / footprint;
+        step_max = std::max(step_max, std::min(norm, limit) / footprint);
         ++num_moved;
       }
       record.mean_step_px = num_moved > 0 ? step_sum / num_moved : 0;
@@ -408,7 +564,8 @@ RefineSummary RefineMesh(const ViewSource& source, const RefineOptions& options,
       record.silhouette_seconds = t_denoise - t_silhouette;
       const Eigen::MatrixXd V_half = V + step;
       if (options.regularizer != "none") {
-        const DenoiseResult denoised = Denoise(V_half, F, denoise);
+        const DenoiseResult denoised =
+            Denoise(V_half, F, denoise, options.noise_from_step ? &V : nullptr);
         record.regularizer_report = denoised.BriefReport();
         V = denoised.V;
       } else {
@@ -432,11 +589,25 @@ RefineSummary RefineMesh(const ViewSource& source, const RefineOptions& options,
       MR_LOG(INFO) << "Level " << level << " iteration " << it + 1 << "/"
                    << options.iterations_per_level << ": similarity " << record.mean_similarity
                    << ", step " << record.mean_step_px << " px (max " << record.max_step_px
-                   << "), " << record.regularizer_report << "; " << record.seconds
+                   << "), " << record.step_filter_report << " " << record.regularizer_report << "; " << record.seconds
                    << " s (data " << record.data_seconds << ", silhouette "
                    << record.silhouette_seconds << ", denoise " << record.denoise_seconds
                    << ", clean-up " << record.cleanup_seconds << ")";
       summary.iterations.push_back(record);
+      // The level has converged when the similarity measured before this
+      // step rose by less than min_improvement over the one before.
+      const size_t n_it = summary.iterations.size();
+      if (it >= 1 && options.min_improvement > 0 &&
+          summary.iterations[n_it - 1].mean_similarity -
+                  summary.iterations[n_it - 2].mean_similarity <
+              options.min_improvement) {
+        MR_LOG(INFO) << "Level " << level << " converged after " << it + 1
+                     << " iterations (similarity " << summary.iterations[n_it - 2].mean_similarity
+                     << " -> " << record.mean_similarity << ", below +" << options.min_improvement
+                     << ")";
+        global_iteration += options.iterations_per_level - it;
+        break;
+      }
     }
   }
 
@@ -469,7 +640,14 @@ RefineSummary RefineMesh(const ViewSource& source, const RefineOptions& options,
 }
 
 void RegisterRefineOptions(OptionManager* o, RefineOptions* r) {
-  o->Add("Refine.num_levels", &r->num_levels, "image pyramid levels, coarse to fine (1..6)");
+  o->Add("Refine.num_levels", &r->num_levels,
+         "image pyramid levels, coarse to fine (1..6; 0: chosen from the input's similarity)");
+  o->Add("Refine.schedule_misalignment_px", &r->schedule_misalignment_px,
+         "num_levels 0: coarse levels until the input's misalignment is below this (pixels)");
+  o->Add("Refine.min_level_image_px", &r->min_level_image_px,
+         "num_levels 0: shortest image side a coarse level may have (pixels)");
+  o->Add("Refine.min_improvement", &r->min_improvement,
+         "a level ends when the mean ZNCC rose by less than this in one iteration (0: never)");
   o->Add("Refine.iterations_per_level", &r->iterations_per_level,
          "gradient + denoising iterations per level (>= 0)");
   o->Add("Refine.target_edge_px", &r->target_edge_px,
@@ -482,6 +660,12 @@ void RegisterRefineOptions(OptionManager* o, RefineOptions* r) {
   o->Add("Refine.similarity", &r->similarity, "dcv (detail-preserving) or zncc");
   o->Add("Refine.kappa", &r->kappa, "final weight of the detail-preserving term (>= 0)");
   o->Add("Refine.regularizer", &r->regularizer, "lp (content-aware L_p), laplacian or none");
+  o->Add("Refine.filter_step", &r->filter_step,
+         "smooth the gradient step by the data confidence (detail-preserving proximal step)");
+  o->Add("Refine.step_smoothing", &r->step_filter.smoothing,
+         "step filter edge weight relative to the median data confidence (> 0)");
+  o->Add("Refine.noise_from_step", &r->noise_from_step,
+         "lp proximal step: noise estimated from what the gradient step added, not the surface");
   o->Add("Refine.silhouette_weight", &r->silhouette_weight,
          "weight of the silhouette term when masks exist (>= 0)");
   o->Add("Refine.prevent_self_intersections", &r->prevent_self_intersections,

@@ -11,6 +11,7 @@
 #include "denoise/denoiser.h"
 #include "refine/photometric.h"
 #include "refine/similarity.h"
+#include "refine/step_filter.h"
 #include "refine/view_selection.h"
 #include "refine/view_source.h"
 
@@ -44,12 +45,25 @@ inline DenoiseOptions ProximalDenoiseOptions() {
 }
 
 struct RefineOptions {
-  // Image pyramid levels (1 = full resolution only; 1..6). 1 suits a
-  // Poisson mesh that is already close; use 3 for a coarse start such as a
-  // visual hull (coarse levels decimate the mesh and lose its detail).
-  int num_levels = 1;
-  // Gradient + denoising iterations at each level (>= 0).
+  // Image pyramid levels (1 = full resolution only; 1..6), or 0: chosen
+  // from the input (ChooseNumLevels in refiner.cc): from how many pixels the
+  // input surface is off the images, measured by optical flow between each
+  // image and its prediction through the mesh. A close start (a Poisson
+  // mesh) keeps full resolution; a far-off one (a visual hull, a decimated
+  // mesh) starts coarse. The choice and its reason are logged.
+  int num_levels = 0;
+  // num_levels 0: add coarse levels until the input's misalignment, divided
+  // by 2 per level, is at most this (full-resolution pixels, > 0).
+  double schedule_misalignment_px = 1.5;
+  // num_levels 0: coarse levels keep at least this many pixels on the short
+  // image side (>= 16).
+  int min_level_image_px = 100;
+  // Largest number of gradient + denoising iterations at each level (>= 0).
   int iterations_per_level = 10;
+  // A level ends early when the mean ZNCC rose by less than this from one
+  // iteration to the next (ZNCC units, >= 0; 0 = always run
+  // iterations_per_level).
+  double min_improvement = 0.0;
   // Target triangle edge length in pixels at every level (> 0). The mesh is
   // remeshed to it when a level starts.
   double target_edge_px = 2.5;
@@ -70,6 +84,15 @@ struct RefineOptions {
   // Regulariser of the proximal step: "lp" (content-aware L_p, the paper's),
   // "laplacian" (1st+2nd order), or "none".
   std::string regularizer = "lp";
+  // Smooth the gradient step by the data confidence before it is taken
+  // (refine/step_filter.h): removes the step's triangle-scale jitter without
+  // touching the surface's relief.
+  bool filter_step = false;
+  StepFilterOptions step_filter;
+  // lp proximal step: estimate the noise to remove from what the gradient
+  // step added (D applied to the step) instead of from the whole surface,
+  // whose relief would count as noise (Denoise's noise_reference).
+  bool noise_from_step = false;
   // Weight of the silhouette (horizon) term when masks exist (>= 0; 0 = off).
   double silhouette_weight = 1.0;
   // Check every iteration for faces that the step made intersect and move
@@ -95,6 +118,7 @@ struct RefineIteration {
   double kappa = 0;
   double mean_step_px = 0;     // mean |gradient step| in pixel footprints
   double max_step_px = 0;
+  std::string step_filter_report;
   std::string regularizer_report;  // e.g. "p=0.5 theta=... sigma=... lambda=..."
   // Where the iteration's time went: renders and pair terms, the silhouette
   // term, the proximal (denoising) step, and the clean-up (flipped faces and
@@ -105,6 +129,7 @@ struct RefineIteration {
 
 struct RefineSummary {
   std::string termination;  // "FINISHED" or why it stopped
+  std::string schedule;     // num_levels 0: what was chosen and why
   int num_views = 0;
   int num_pairs = 0;
   int initial_faces = 0, final_faces = 0;

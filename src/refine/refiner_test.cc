@@ -98,6 +98,63 @@ TEST_F(RefinerTest, NoisyMeshGetsCloserToGroundTruth) {
   EXPECT_GT(summary.final_similarity, summary.initial_similarity);
 }
 
+// RMS of the radial relief |x| - mean |x| over the vertices (bumpy sphere).
+double ReliefRms(const Eigen::MatrixXd& V) {
+  const Eigen::VectorXd r = V.rowwise().norm();
+  return std::sqrt((r.array() - r.mean()).square().mean());
+}
+
+// Detail preservation: started from a noise-free curved surface with fine
+// relief (the truth), the defaults keep the bump field. Bound: at most 5 % of
+// its RMS lost (the refiner's own remeshing to 2.5 px triangles is the
+// reference, as it sets what the mesh can hold).
+TEST_F(RefinerTest, DefaultsKeepFineRelief) {
+  Eigen::MatrixXd V;
+  Eigen::MatrixXi F;
+  MakeBumpySphere(5, 0.06, &V, &F);
+  const InMemoryViewSource source = MakeTestScene(V, F, {}, {}, renderer_);
+  TriangleMesh mesh;
+  mesh.V = V;
+  mesh.F = F;
+  RefineOptions options;  // defaults
+  options.iterations_per_level = 6;
+  RefineOptions remesh_only = options;
+  remesh_only.iterations_per_level = 0;
+  TriangleMesh remeshed = mesh;
+  RefineMesh(source, remesh_only, &remeshed, renderer_);
+  const RefineSummary summary = RefineMesh(source, options, &mesh, renderer_);
+  const double before = ReliefRms(remeshed.V), after = ReliefRms(mesh.V);
+  RecordProperty("relief_rms_before", std::to_string(before));
+  RecordProperty("relief_rms_after", std::to_string(after));
+  EXPECT_GT(after, 0.95 * before) << "relief RMS " << before << " -> " << after << "\n"
+                                  << summary.FullReport();
+}
+
+// The schedule chooses itself: no coarse level for a start that is already
+// close (the truth), coarse levels for a far-off one (a sphere 12 % too big,
+// several pixels off in every view).
+TEST_F(RefinerTest, ScheduleFollowsTheStart) {
+  Eigen::MatrixXd V;
+  Eigen::MatrixXi F;
+  MakeBumpySphere(5, 0.06, &V, &F);
+  TestSceneOptions scene;
+  scene.width = 320;
+  scene.height = 240;
+  const InMemoryViewSource source = MakeTestScene(V, F, scene, {}, renderer_);
+  RefineOptions options;  // num_levels 0: chosen from the input
+  options.iterations_per_level = 1;
+  TriangleMesh close;
+  close.V = V;
+  close.F = F;
+  const RefineSummary close_summary = RefineMesh(source, options, &close, renderer_);
+  EXPECT_EQ(close_summary.iterations.front().level, 0) << close_summary.schedule;
+  TriangleMesh far;
+  MakeIcosphere(4, 1.12, &far.V, &far.F);
+  const RefineSummary far_summary = RefineMesh(source, options, &far, renderer_);
+  EXPECT_GE(far_summary.iterations.front().level, 1) << far_summary.schedule;
+  EXPECT_NE(far_summary.schedule.find("levels"), std::string::npos) << far_summary.schedule;
+}
+
 TEST_F(RefinerTest, InvariantToRotationAndScale) {
   Eigen::MatrixXd V;
   Eigen::MatrixXi F;
