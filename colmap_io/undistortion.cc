@@ -10,6 +10,7 @@
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 
+#include "colmap_io/image_file.h"
 #include "util/error.h"
 #include "util/file.h"
 #include "util/logging.h"
@@ -203,8 +204,7 @@ UndistortionSummary UndistortSparseModel(const std::string& image_dir,
     const Camera& camera = model.cameras.at(image.camera_id);
     const auto& [mx, my] = maps.at(image.camera_id);
     const std::string src = JoinPaths(image_dir, image.name);
-    const cv::Mat in = cv::imread(src, cv::IMREAD_UNCHANGED);
-    if (in.empty()) MR_THROW_INPUT << src << ": cannot read image " << id;
+    const cv::Mat in = ReadImageFile(src, cv::IMREAD_UNCHANGED, "image " + std::to_string(id));
     if (in.cols != static_cast<int>(camera.width) || in.rows != static_cast<int>(camera.height)) {
       MR_THROW_INPUT << src << ": image is " << in.cols << "x" << in.rows << " but camera "
                      << camera.camera_id << " is " << camera.width << "x" << camera.height;
@@ -217,8 +217,7 @@ UndistortionSummary UndistortSparseModel(const std::string& image_dir,
     if (!mask_dir.empty()) {
       const std::string mask_path = JoinPaths(mask_dir, image.name + ".png");
       if (ExistsFile(mask_path)) {
-        const cv::Mat mask = cv::imread(mask_path, cv::IMREAD_GRAYSCALE);
-        if (mask.empty()) MR_THROW_INPUT << mask_path << ": cannot read mask";
+        const cv::Mat mask = ReadImageFile(mask_path, cv::IMREAD_GRAYSCALE, "mask");
         if (mask.size() != in.size()) {
           MR_THROW_INPUT << mask_path << ": mask is " << mask.cols << "x" << mask.rows
                          << " but its image is " << in.cols << "x" << in.rows;

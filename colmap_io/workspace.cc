@@ -5,6 +5,7 @@
 
 #include <opencv2/imgcodecs.hpp>
 
+#include "colmap_io/image_file.h"
 #include "colmap_io/undistortion.h"
 #include "util/error.h"
 #include "util/file.h"
@@ -209,8 +210,8 @@ void CheckSize(const std::string& path, const cv::Mat& mat, const Camera& camera
 
 cv::Mat Workspace::ReadImage(uint32_t image_id, bool grayscale) const {
   const std::string path = ImagePath(image_id);
-  const cv::Mat image = cv::imread(path, grayscale ? cv::IMREAD_GRAYSCALE : cv::IMREAD_COLOR);
-  if (image.empty()) MR_THROW_INPUT << path << ": cannot read image (missing or not an image)";
+  const cv::Mat image =
+      ReadImageFile(path, grayscale ? cv::IMREAD_GRAYSCALE : cv::IMREAD_COLOR, "image");
   CheckSize(path, image, model.cameras.at(model.images.at(image_id).camera_id));
   return image;
 }
@@ -218,8 +219,7 @@ cv::Mat Workspace::ReadImage(uint32_t image_id, bool grayscale) const {
 cv::Mat Workspace::ReadMask(uint32_t image_id) const {
   const std::string path = MaskPath(image_id);
   if (path.empty()) return cv::Mat();
-  const cv::Mat mask = cv::imread(path, cv::IMREAD_GRAYSCALE);
-  if (mask.empty()) MR_THROW_INPUT << path << ": cannot read mask";
+  const cv::Mat mask = ReadImageFile(path, cv::IMREAD_GRAYSCALE, "mask");
   CheckSize(path, mask, model.cameras.at(model.images.at(image_id).camera_id));
   return mask;
 }

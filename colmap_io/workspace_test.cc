@@ -2,10 +2,11 @@
 
 #include <chrono>
 #include <filesystem>
-#include <thread>
 #include <fstream>
+#include <thread>
 
 #include <gtest/gtest.h>
+#include <opencv2/core.hpp>
 #include <opencv2/imgcodecs.hpp>
 
 #include "colmap_io/test_models.h"
@@ -68,6 +69,55 @@ std::string MakeWorkspace(const TempDir& dir, const Reconstruction& model, const
     WriteSparseModelBinary(s, model);
   }
   return dir.path();
+}
+
+void WriteBytes(const std::string& path, const std::string& bytes) {
+  std::ofstream(path, std::ios::binary | std::ios::trunc) << bytes;
+}
+
+std::string Encode(const std::string& ext, const cv::Mat& image) {
+  std::vector<uchar> buffer;
+  EXPECT_TRUE(cv::imencode(ext, image, buffer));
+  return std::string(buffer.begin(), buffer.end());
+}
+
+// A JPEG (as written by OpenCV) with an APP1 Exif segment holding only
+// Orientation = `orientation` inserted right after SOI, as cameras write it.
+std::string JpegWithExifOrientation(const cv::Mat& image, int orientation) {
+  const std::string jpeg = Encode(".jpg", image);
+  std::string tiff("II*\0\x08\0\0\0", 8);          // little-endian TIFF header, IFD at 8
+  tiff += std::string("\x01\0", 2);                  // 1 entry
+  tiff += std::string("\x12\x01\x03\0\x01\0\0\0", 8);  // tag 0x0112 SHORT, count 1
+  tiff += std::string(1, static_cast<char>(orientation)) + std::string(3, '\0');
+  tiff += std::string(4, '\0');                       // no next IFD
+  const std::string payload = std::string("Exif\0\0", 6) + tiff;
+  const size_t length = payload.size() + 2;
+  std::string app1 = "\xff\xe1";
+  app1 += static_cast<char>(length >> 8);
+  app1 += static_cast<char>(length & 0xff);
+  app1 += payload;
+  return jpeg.substr(0, 2) + app1 + jpeg.substr(2);
+}
+
+// 640x480, four quadrants of different grey so that any turn or flip shows.
+cv::Mat QuadrantImage(int type) {
+  cv::Mat image(480, 640, type);
+  image(cv::Rect(0, 0, 320, 240)).setTo(cv::Scalar::all(30));
+  image(cv::Rect(320, 0, 320, 240)).setTo(cv::Scalar::all(220));
+  image(cv::Rect(0, 240, 320, 240)).setTo(cv::Scalar::all(120));
+  image(cv::Rect(320, 240, 320, 240)).setTo(cv::Scalar::all(180));
+  return image;
+}
+
+void ExpectQuadrants(const cv::Mat& image, const std::string& what) {
+  ASSERT_EQ(image.cols, 640) << what;
+  ASSERT_EQ(image.rows, 480) << what;
+  cv::Mat gray = image;
+  if (image.channels() == 3) cv::extractChannel(image, gray, 1);
+  EXPECT_NEAR(gray.at<uint8_t>(100, 100), 30, 6) << what;
+  EXPECT_NEAR(gray.at<uint8_t>(100, 540), 220, 6) << what;
+  EXPECT_NEAR(gray.at<uint8_t>(380, 100), 120, 6) << what;
+  EXPECT_NEAR(gray.at<uint8_t>(380, 540), 180, 6) << what;
 }
 
 TEST(WorkspaceOptions, DefaultsAreValid) { EXPECT_TRUE(WorkspaceOptions().Check()); }
@@ -277,6 +327,95 @@ TEST(Workspace, CustomImageFolder) {
   options.image_path = dir.path() + "/elsewhere";
   const Workspace ws = OpenWorkspace(dir.path(), options);
   EXPECT_EQ(ws.ImagePath(1), dir.path() + "/elsewhere/c.png");
+}
+
+// COLMAP reads the raw pixels and ignores EXIF orientation (its undistorter
+// copies the pixels and keeps the tag): a 640x480 JPEG tagged Orientation = 6
+// is a 640x480 image here too, unrotated; so are masks and the images and
+// masks of a distorted project.
+TEST(Workspace, ExifOrientationIsIgnored) {
+  for (const CameraModel camera_model : {CameraModel::kPinhole, CameraModel::kSimpleRadial}) {
+    TempDir dir("ws_exif");
+    Reconstruction model = camera_model == CameraModel::kPinhole
+                               ? MakeModel(camera_model, {500, 500, 320, 240})
+                               : MakeModel(camera_model, {500, 320, 240, 0.0});
+    model.cameras.at(1).width = 640;
+    model.cameras.at(1).height = 480;
+    for (auto& [id, image] : model.images) image.name = "view_" + std::to_string(id) + ".jpg";
+    const std::string images = dir.Sub("images"), masks = dir.Sub("masks");
+    for (const auto& [id, image] : model.images) {
+      WriteBytes(images + "/" + image.name, JpegWithExifOrientation(QuadrantImage(CV_8UC3), 6));
+      // A mask is found by its name; its content may be any format OpenCV reads.
+      WriteBytes(masks + "/" + image.name + ".png",
+                 JpegWithExifOrientation(QuadrantImage(CV_8UC1), 6));
+    }
+    // Check that the tag is there: a reader that applies it turns the image.
+    ASSERT_EQ(cv::imread(images + "/view_1.jpg", cv::IMREAD_COLOR).cols, 480);
+    WriteSparseModelBinary(dir.Sub(camera_model == CameraModel::kPinhole ? "sparse" : "sparse/0"),
+                           model);
+    const Workspace ws = OpenWorkspace(dir.path());
+    const std::string what = CameraModelName(camera_model);
+    ExpectQuadrants(ws.ReadImage(1, /*grayscale=*/false), what + " color");
+    ExpectQuadrants(ws.ReadImage(1, /*grayscale=*/true), what + " gray");
+    ExpectQuadrants(ws.ReadMask(1), what + " mask");
+  }
+}
+
+// libjpeg only warns ("Premature end of JPEG file") and OpenCV returns the
+// grey-filled rest: a cut image is an error naming the file, for images and
+// masks, in a dense workspace and when undistorting a sparse project.
+TEST(Workspace, TruncatedImagesAreRefused) {
+  cv::Mat noise(48, 64, CV_8UC3);
+  cv::randu(noise, cv::Scalar::all(0), cv::Scalar::all(255));
+  const std::string jpeg = Encode(".jpg", noise), png = Encode(".png", noise);
+  for (const std::string& bytes : {jpeg.substr(0, jpeg.size() / 2), png.substr(0, png.size() / 2)}) {
+    TempDir dir("ws_truncated");
+    const std::string root = MakeWorkspace(dir, PinholeModel(), "sparse");
+    WriteBytes(root + "/images/a.png", bytes);
+    const Workspace ws = OpenWorkspace(root);
+    ExpectInputError([&] { ws.ReadImage(2, true); },
+                     {root + "/images/a.png", "truncated or corrupt image"});
+    ExpectInputError([&] { ws.ReadImage(2, false); },
+                     {root + "/images/a.png", "truncated or corrupt image"});
+    EXPECT_EQ(ws.ReadImage(1, true).cols, 64);
+
+    // A mask.
+    const std::string masks = dir.Sub("masks");
+    dir.Sub("masks/sub");
+    WriteBytes(root + "/images/a.png", png);
+    ASSERT_TRUE(cv::imwrite(masks + "/c.png.png", cv::Mat(48, 64, CV_8UC1, cv::Scalar(255))));
+    ASSERT_TRUE(cv::imwrite(masks + "/sub/b.png.png", cv::Mat(48, 64, CV_8UC1, cv::Scalar(255))));
+    WriteBytes(masks + "/a.png.png", bytes);
+    ExpectInputError(
+        [&] {
+          const Workspace with_masks = OpenWorkspace(root);
+          with_masks.ReadMask(2);
+        },
+        {masks + "/a.png.png", "truncated or corrupt image"});
+  }
+  // Undistortion of a sparse project reads them too.
+  for (const std::string& bytes : {jpeg.substr(0, jpeg.size() / 2), png.substr(0, png.size() / 2)}) {
+    TempDir dir("ws_truncated_distorted");
+    const std::string root = MakeWorkspace(dir, DistortedModel(), "sparse/0");
+    WriteBytes(root + "/images/sub/b.png", bytes);
+    ExpectInputError([&] { OpenWorkspace(root); },
+                     {root + "/images/sub/b.png", "truncated or corrupt image"});
+  }
+}
+
+// Complete files with zero padding or data after the end of the image (as
+// some cameras append) are read.
+TEST(Workspace, CompleteImagesWithTrailingBytesAreRead) {
+  cv::Mat noise(48, 64, CV_8UC3);
+  cv::randu(noise, cv::Scalar::all(0), cv::Scalar::all(255));
+  const std::string jpeg = Encode(".jpg", noise), png = Encode(".png", noise);
+  for (const std::string& bytes : {jpeg + std::string(100, '\0'), jpeg + "appended data",
+                                   png + std::string(16, '\0'), JpegWithExifOrientation(noise, 1)}) {
+    TempDir dir("ws_trailing");
+    const std::string root = MakeWorkspace(dir, PinholeModel(), "sparse");
+    WriteBytes(root + "/images/a.png", bytes);
+    EXPECT_EQ(OpenWorkspace(root).ReadImage(2, false).cols, 64);
+  }
 }
 
 }  // namespace

@@ -12,6 +12,7 @@
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 
+#include "colmap_io/image_file.h"
 #include "util/error.h"
 #include "util/file.h"
 #include "util/logging.h"
@@ -386,7 +387,10 @@ MiddleburyConversionSummary ConvertMiddlebury(const std::string& input_path,
     const std::string bytes = ReadFileToString(src);
     const cv::Mat raw(1, static_cast<int>(bytes.size()), CV_8U,
                       const_cast<char*>(bytes.data()));
-    const cv::Mat image = cv::imdecode(raw, cv::IMREAD_COLOR);
+    // The bytes are copied as they are: the camera must match the raw pixels
+    // (EXIF orientation ignored, as COLMAP and our workspace reader do).
+    CheckImageComplete(src, bytes);
+    const cv::Mat image = cv::imdecode(raw, cv::IMREAD_COLOR | cv::IMREAD_IGNORE_ORIENTATION);
     if (image.empty()) MR_THROW_INPUT << src << ": cannot decode the image";
     const uint32_t id = static_cast<uint32_t>(i + 1);
     Camera camera;
