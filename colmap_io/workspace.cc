@@ -45,10 +45,36 @@ std::string FindSparseDir(const std::string& root) {
   return best < 0 ? "" : JoinPaths(sparse, std::to_string(best));
 }
 
+// Up to `max` items joined with ", ", then ", ..." if there are more.
+std::string Examples(const std::vector<std::string>& items, size_t max = 3) {
+  std::string list;
+  for (size_t i = 0; i < items.size() && i < max; ++i) list += (i ? ", " : "") + items[i];
+  if (items.size() > max) list += ", ...";
+  return list;
+}
+
+// Checks the masks and logs what is wrong with them; throws if none matches.
+void ReportMasks(const std::string& mask_dir, const Reconstruction& model) {
+  const MaskCheck check = CheckMasks(mask_dir, model);
+  if (!check.missing.empty()) {
+    MR_LOG(WARNING) << mask_dir << ": " << check.missing.size() << " of " << check.num_images
+                    << " images have no mask (expected <image name>.png, e.g. "
+                    << check.missing.front() << ".png); those images are used without a mask";
+  }
+  if (!check.empty.empty()) {
+    MR_LOG(WARNING) << check.empty.size() << " of " << check.num_images - check.missing.size()
+                    << " masks are all background (no nonzero pixel; nonzero marks the object): "
+                    << Examples(check.empty, 5);
+  }
+}
+
 bool IsEmptyDir(const std::string& dir) {
   std::error_code ec;
   return fs::is_empty(dir, ec) && !ec;
 }
+
+Workspace OpenWorkspaceImpl(const std::string& path, const WorkspaceOptions& options,
+                            bool check_masks);
 
 Workspace OpenUndistorted(const std::string& root, const std::string& image_dir,
                           const std::string& mask_dir, const std::string& sparse_dir,
@@ -91,18 +117,15 @@ Workspace OpenUndistorted(const std::string& root, const std::string& image_dir,
   if (!mask_dir.empty() && ExistsDir(JoinPaths(out, "masks"))) {
     dense_options.mask_path = JoinPaths(out, "masks");
   }
-  Workspace ws = OpenWorkspace(out, dense_options);
+  // The source masks were checked; the undistorted ones are the same set.
+  Workspace ws = OpenWorkspaceImpl(out, dense_options, /*check_masks=*/false);
   if (mask_dir.empty()) ws.mask_dir.clear();
   ws.undistortion = how;
   return ws;
 }
 
-}  // namespace
-
-bool WorkspaceOptions::Check() const { return true; }
-
-Workspace OpenWorkspace(const std::string& path, const WorkspaceOptions& options) {
-  options.Check();
+Workspace OpenWorkspaceImpl(const std::string& path, const WorkspaceOptions& options,
+                            bool check_masks) {
   if (!ExistsDir(path)) MR_THROW_INPUT << path << ": workspace folder does not exist";
   const std::string image_dir =
       options.image_path.empty() ? JoinPaths(path, "images") : options.image_path;
@@ -122,7 +145,8 @@ Workspace OpenWorkspace(const std::string& path, const WorkspaceOptions& options
   }
 
   std::string mask_dir;
-  if (!options.mask_path.empty()) {
+  if (!options.use_masks) {
+  } else if (!options.mask_path.empty()) {
     if (!ExistsDir(options.mask_path)) {
       MR_THROW_INPUT << options.mask_path << ": mask folder does not exist";
     }
@@ -147,6 +171,8 @@ Workspace OpenWorkspace(const std::string& path, const WorkspaceOptions& options
                    << " are missing: " << list;
   }
 
+  if (check_masks && !mask_dir.empty()) ReportMasks(mask_dir, model);
+
   const bool all_pinhole =
       std::all_of(model.cameras.begin(), model.cameras.end(),
                   [](const auto& c) { return IsPinholeModel(c.second.model); });
@@ -166,6 +192,43 @@ Workspace OpenWorkspace(const std::string& path, const WorkspaceOptions& options
                << ws.model.cameras.size() << " cameras, " << ws.model.points3D.size()
                << " points3D" << (mask_dir.empty() ? "" : ", masks in " + mask_dir);
   return ws;
+}
+
+}  // namespace
+
+bool WorkspaceOptions::Check() const { return true; }
+
+Workspace OpenWorkspace(const std::string& path, const WorkspaceOptions& options) {
+  options.Check();
+  return OpenWorkspaceImpl(path, options, /*check_masks=*/true);
+}
+
+MaskCheck CheckMasks(const std::string& mask_dir, const Reconstruction& model) {
+  std::vector<std::string> names;
+  for (const auto& [id, image] : model.images) names.push_back(image.name);
+  std::sort(names.begin(), names.end());
+  MaskCheck check;
+  check.num_images = static_cast<int>(names.size());
+  for (const std::string& name : names) {
+    // COLMAP's convention: "<image name>.png" (images/a.jpg -> masks/a.jpg.png).
+    const std::string path = JoinPaths(mask_dir, name + ".png");
+    if (!ExistsFile(path)) {
+      check.missing.push_back(name);
+      continue;
+    }
+    if (cv::countNonZero(ReadImageFile(path, cv::IMREAD_GRAYSCALE, "mask")) == 0) {
+      check.empty.push_back(path);
+    }
+  }
+  if (!names.empty() && check.missing.size() == names.size()) {
+    const std::vector<std::string> files = ListFiles(mask_dir);
+    MR_THROW_INPUT << mask_dir << ": no mask matches the images; expected <image name>.png such as "
+                   << names.front() << ".png, found "
+                   << (files.empty() ? "no files" : std::to_string(files.size()) +
+                                                        " files such as " + Examples(files))
+                   << " (COLMAP's naming: images/a.jpg -> masks/a.jpg.png)";
+  }
+  return check;
 }
 
 std::string Workspace::ImagePath(uint32_t image_id) const {

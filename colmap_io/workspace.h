@@ -31,6 +31,9 @@ struct WorkspaceOptions {
   std::string mask_path;
   // Folder of the images; empty: <workspace>/images.
   std::string image_path;
+  // false: no masks are looked for or checked (mask_dir stays ""), for
+  // programs that use only the cameras.
+  bool use_masks = true;
 
   bool Check() const;
 };
@@ -59,7 +62,21 @@ struct Workspace {
 
 // Opens a dense or sparse workspace. Throws InputError with the path and
 // what is missing (no images/, no sparse model, images listed in the model
-// but missing from images/, ...).
+// but missing from images/, a mask folder none of whose masks matches an
+// image, ...). Masks missing for some images and masks that are all
+// background are logged as warnings (see CheckMasks).
 Workspace OpenWorkspace(const std::string& path, const WorkspaceOptions& options = {});
+
+// What CheckMasks found in a mask folder.
+struct MaskCheck {
+  int num_images = 0;                // images in the model
+  std::vector<std::string> missing;  // names of images without a mask, sorted
+  std::vector<std::string> empty;    // paths of masks with no nonzero pixel, sorted by image
+};
+
+// Looks for "<image name>.png" in `mask_dir` for every image of `model` and
+// reads each one found. Throws InputError if none is found (saying which
+// name was expected, e.g. "view_0000.png.png"), or if a mask cannot be read.
+MaskCheck CheckMasks(const std::string& mask_dir, const Reconstruction& model);
 
 }  // namespace mr

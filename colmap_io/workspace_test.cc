@@ -418,5 +418,70 @@ TEST(Workspace, CompleteImagesWithTrailingBytesAreRead) {
   }
 }
 
+// Masks named after the image files (view.png) instead of COLMAP's
+// "<image name>.png" (view.png.png): none is found, which is an error that
+// says what was expected; for a distorted project too.
+TEST(Workspace, MasksMatchingNoImageAreAnError) {
+  for (const std::string sparse : {"sparse", "sparse/0"}) {
+    TempDir dir("ws_masks_no_match");
+    const std::string root =
+        MakeWorkspace(dir, sparse == "sparse" ? PinholeModel() : DistortedModel(), sparse);
+    const std::string masks = dir.Sub("masks");
+    dir.Sub("masks/sub");
+    for (const char* name : {"a.png", "c.png", "sub/b.png"}) {
+      ASSERT_TRUE(cv::imwrite(masks + "/" + name, cv::Mat(48, 64, CV_8UC1, cv::Scalar(255))));
+    }
+    ExpectInputError([&] { OpenWorkspace(root); },
+                     {masks, "no mask matches the images",
+                      "expected <image name>.png such as a.png.png", "found 2 files such as a.png"});
+    // A program that uses only the cameras does not look at masks.
+    WorkspaceOptions options;
+    options.use_masks = false;
+    EXPECT_EQ(OpenWorkspace(root, options).mask_dir, "");
+  }
+}
+
+TEST(Workspace, CheckMasks) {
+  TempDir dir("ws_check_masks");
+  const Reconstruction model = PinholeModel();
+  const std::string masks = dir.Sub("masks");
+  dir.Sub("masks/sub");
+  ASSERT_TRUE(cv::imwrite(masks + "/a.png.png", cv::Mat(48, 64, CV_8UC1, cv::Scalar(0))));
+  ASSERT_TRUE(cv::imwrite(masks + "/sub/b.png.png", cv::Mat(48, 64, CV_8UC1, cv::Scalar(0))));
+  MaskCheck check = CheckMasks(masks, model);
+  EXPECT_EQ(check.num_images, 3);
+  EXPECT_EQ(check.missing, (std::vector<std::string>{"c.png"}));
+  EXPECT_EQ(check.empty, (std::vector<std::string>{masks + "/a.png.png", masks + "/sub/b.png.png"}));
+  cv::Mat one(48, 64, CV_8UC1, cv::Scalar(0));
+  one.at<uint8_t>(47, 63) = 1;  // a single foreground pixel is enough
+  ASSERT_TRUE(cv::imwrite(masks + "/a.png.png", one));
+  ASSERT_TRUE(cv::imwrite(masks + "/c.png.png", one));
+  check = CheckMasks(masks, model);
+  EXPECT_TRUE(check.missing.empty());
+  EXPECT_EQ(check.empty, (std::vector<std::string>{masks + "/sub/b.png.png"}));
+  // A mask that cannot be read is an error when the workspace is opened.
+  std::ofstream(masks + "/c.png.png") << "not an image";
+  ExpectInputError([&] { CheckMasks(masks, model); }, {masks + "/c.png.png", "mask"});
+}
+
+// Masks missing for some images, and masks with no foreground pixel, are
+// reported with a warning (the run goes on).
+TEST(Workspace, MissingAndEmptyMasksAreReported) {
+  TempDir dir("ws_masks_partial");
+  const std::string root = MakeWorkspace(dir, PinholeModel(), "sparse");
+  const std::string masks = dir.Sub("masks");
+  ASSERT_TRUE(cv::imwrite(masks + "/a.png.png", cv::Mat(48, 64, CV_8UC1, cv::Scalar(255))));
+  ASSERT_TRUE(cv::imwrite(masks + "/c.png.png", cv::Mat(48, 64, CV_8UC1, cv::Scalar(0))));
+  ::testing::internal::CaptureStderr();
+  const Workspace ws = OpenWorkspace(root);
+  const std::string log = ::testing::internal::GetCapturedStderr();
+  EXPECT_EQ(ws.mask_dir, masks);
+  EXPECT_NE(log.find("1 of 3 images have no mask"), std::string::npos) << log;
+  EXPECT_NE(log.find("sub/b.png.png"), std::string::npos) << log;
+  EXPECT_NE(log.find(masks + "/c.png.png"), std::string::npos) << log;
+  EXPECT_NE(log.find("all background"), std::string::npos) << log;
+  EXPECT_EQ(log.find(masks + "/a.png.png"), std::string::npos) << log;
+}
+
 }  // namespace
 }  // namespace mr

@@ -52,7 +52,9 @@ int main(int argc, char** argv) {
     std::vector<char> observed;
     if (!workspace_path.empty()) {
       if (min_views < 1) MR_THROW_INPUT << "--min_views " << min_views << ": expected >= 1";
-      const mr::Workspace workspace = mr::OpenWorkspace(workspace_path);
+      mr::WorkspaceOptions ws_options;
+      ws_options.use_masks = false;  // only the cameras are used
+      const mr::Workspace workspace = mr::OpenWorkspace(workspace_path, ws_options);
       std::vector<mr::PinholeView> views;
       for (uint32_t id : workspace.image_ids) {
         const mr::Image& image = workspace.model.images.at(id);

@@ -91,7 +91,9 @@ int main(int argc, char** argv) {
 
     std::unique_ptr<mr::Workspace> ws;
     if (!workspace_path.empty()) {
-      ws = std::make_unique<mr::Workspace>(mr::OpenWorkspace(workspace_path));
+      mr::WorkspaceOptions ws_options;
+      ws_options.use_masks = false;  // only the cameras are used
+      ws = std::make_unique<mr::Workspace>(mr::OpenWorkspace(workspace_path, ws_options));
     }
     mr::PinholeView view;
     if (!image_name.empty()) {
