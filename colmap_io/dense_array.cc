@@ -101,6 +101,7 @@ std::vector<std::vector<uint32_t>> ReadFusedVisibility(const std::string& path) 
       MR_THROW_INPUT << path << ": truncated file: point " << i << " lists " << n
                      << " images but only " << data.size() - pos << " bytes are left";
     }
+    if (n == 0) continue;  // seen by no image: the empty list's data() may be null
     visibility[i].resize(n);
     std::memcpy(visibility[i].data(), data.data() + pos, n * sizeof(uint32_t));
     pos += n * sizeof(uint32_t);

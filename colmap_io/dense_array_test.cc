@@ -119,6 +119,22 @@ TEST(FusedVisibility, RoundTrip) {
   EXPECT_TRUE(ReadFusedVisibility(path).empty());
 }
 
+// Points seen by no image (COLMAP writes a count of 0 and nothing after it):
+// reading them must not copy from the empty list's null data pointer
+// (UBSan: "null pointer passed as argument 1 ... declared to never be null").
+TEST(FusedVisibility, ZeroVisibleImages) {
+  TempDir dir("vis_zero");
+  const std::string path = dir.path() + "/fused.ply.vis";
+  for (const std::vector<std::vector<uint32_t>>& vis :
+       std::vector<std::vector<std::vector<uint32_t>>>{{{}}, {{}, {}, {}}, {{}, {4}, {}}}) {
+    WriteFusedVisibility(path, vis);
+    size_t ids = 0;
+    for (const auto& images : vis) ids += images.size();
+    EXPECT_EQ(ReadFileToString(path).size(), 8u + 4 * vis.size() + 4 * ids);
+    EXPECT_EQ(ReadFusedVisibility(path), vis);
+  }
+}
+
 TEST(FusedVisibility, TruncatedAndCorrupt) {
   TempDir dir("vis_bad");
   const std::string path = dir.path() + "/fused.ply.vis";
