@@ -144,6 +144,8 @@ bool IsPinholeModel(CameraModel model) {
   return model == CameraModel::kSimplePinhole || model == CameraModel::kPinhole;
 }
 
+bool HasSeparateFocalLengths(CameraModel model) { return Info(model).separate_focal; }
+
 double CameraFocalX(CameraModel model, const std::vector<double>& params) {
   CheckParams(model, params);
   return params[0];

@@ -34,6 +34,9 @@ int CameraModelNumParams(CameraModel model);
 // True for SIMPLE_PINHOLE and PINHOLE (no distortion).
 bool IsPinholeModel(CameraModel model);
 
+// True if the model has separate focal lengths fx, fy (else a single f).
+bool HasSeparateFocalLengths(CameraModel model);
+
 // Focal lengths and principal point of any model (f is duplicated for the
 // SIMPLE_* models).
 double CameraFocalX(CameraModel model, const std::vector<double>& params);

@@ -55,7 +55,8 @@ void CheckPng(const std::string& path, const std::string& data) {
   size_t pos = 8;  // after the signature
   while (true) {
     if (pos + 8 > data.size()) Truncated(path, "PNG ends before its IEND chunk");
-    const uint64_t length = (uint64_t(Byte(data, pos)) << 24) | (uint64_t(Byte(data, pos + 1)) << 16) |
+    const uint64_t length = (uint64_t(Byte(data, pos)) << 24) |
+                            (uint64_t(Byte(data, pos + 1)) << 16) |
                             (uint64_t(Byte(data, pos + 2)) << 8) | Byte(data, pos + 3);
     const std::string type = data.substr(pos + 4, 4);
     if (pos + 12 + length > data.size()) {

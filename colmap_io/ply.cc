@@ -146,6 +146,14 @@ class BodyReader {
         swap_((format == PlyFormat::kBinaryBigEndian) == HostIsLittleEndian()) {}
 
   bool binary() const { return format_ != PlyFormat::kAscii; }
+  // Byte offset of the next value in the file.
+  size_t offset() const { return static_cast<size_t>(pos_ - begin_); }
+  // ASCII: only blanks are left on the current line (records end lines).
+  bool AtLineEnd() const {
+    const char* p = pos_;
+    while (p != end_ && (*p == ' ' || *p == '\t' || *p == '\r')) ++p;
+    return p == end_ || *p == '\n';
+  }
 
   // Reads one scalar of `type`; `what` names it in errors.
   double Read(ScalarType type, const Element& element, int64_t record) {
@@ -352,6 +360,54 @@ uint8_t ToColor(double v, ScalarType type) {
   return static_cast<uint8_t>(std::lround(v));
 }
 
+// Binary files whose face element failed to read: the number of vertices
+// after which the faces would read exactly to the end of the file, when that
+// is fewer than the header claims (the header overstates the vertex count);
+// else -1. Only for the common layout: fixed-size vertex records directly
+// followed by the last element, faces with the index list as only property.
+int64_t VerticesBeforeFaces(const std::string& data, const Header& header, int vertex_element,
+                            int face_element, int face_list, size_t face_begin, bool swap) {
+  const Element& vertex = header.elements[vertex_element];
+  const Element& face = header.elements[face_element];
+  const int64_t vertex_size = vertex.FixedSize();
+  if (vertex_size <= 0 || face_element != vertex_element + 1 ||
+      face_element + 1 != static_cast<int>(header.elements.size()) ||
+      face.properties.size() != 1 || face_list != 0) {
+    return -1;
+  }
+  const int count_size = ScalarSize(face.properties[0].count_type);
+  const int index_size = ScalarSize(face.properties[0].type);
+  const ScalarType count_type = face.properties[0].count_type, index_type = face.properties[0].type;
+  const char* end = data.data() + data.size();
+  int64_t budget = 4 * face.count + (int64_t(1) << 24);  // faces walked in all
+  for (int64_t missing = 1; missing <= vertex.count && budget > 0; ++missing) {
+    const int64_t held = vertex.count - missing;
+    const char* p = data.data() + face_begin - missing * vertex_size;
+    bool ok = true;
+    for (int64_t f = 0; ok && f < face.count; ++f, --budget) {
+      if (end - p < count_size) {
+        ok = false;
+        break;
+      }
+      const double n = LoadScalar(p, count_type, swap);
+      p += count_size;
+      if (n < 3 || (end - p) / index_size < n) {
+        ok = false;
+        break;
+      }
+      for (int64_t j = 0; j < static_cast<int64_t>(n); ++j, p += index_size) {
+        const double index = LoadScalar(p, index_type, swap);
+        if (index < 0 || index >= static_cast<double>(held)) {
+          ok = false;
+          break;
+        }
+      }
+    }
+    if (ok && p == end) return held;
+  }
+  return -1;
+}
+
 }  // namespace
 
 TriangleMesh ReadPly(const std::string& path) {
@@ -410,22 +466,31 @@ TriangleMesh ReadPly(const std::string& path) {
   }
 
   // Fail fast on an obviously short body (before allocating for the counts
-  // the header claims). ASCII values take at least one character each.
+  // the header claims). ASCII values take at least two characters each (the
+  // value and a separator; the file's last value may lack its newline).
   {
     const bool ascii = header.format == PlyFormat::kAscii;
-    double min_size = 0;
+    double min_size = ascii ? -1 : 0;
+    const double available = static_cast<double>(data.size() - header.body_offset);
+    std::string room;  // where the file must end, for the message
     for (const Element& element : header.elements) {
       double record = 0;
       for (const Property& p : element.properties) {
-        record += ascii ? 1 : (p.is_list ? ScalarSize(p.count_type) : ScalarSize(p.type));
+        record += ascii ? 2 : (p.is_list ? ScalarSize(p.count_type) : ScalarSize(p.type));
       }
+      const double before = std::max(0.0, min_size);
       min_size += record * static_cast<double>(element.count);
+      if (room.empty() && available < min_size && record > 0) {
+        const int64_t fit = static_cast<int64_t>(std::max(0.0, (available - before) / record));
+        room = "room for at most " + std::to_string(fit) + " of " +
+               std::to_string(element.count) + " " + element.name + " records";
+      }
     }
-    const double available = static_cast<double>(data.size() - header.body_offset);
     if (available < min_size) {
       MR_THROW_INPUT << path << ": truncated PLY body: the header needs at least "
                      << static_cast<int64_t>(min_size) << (ascii ? " characters" : " bytes")
-                     << " after the header, the file has " << static_cast<int64_t>(available);
+                     << " after the header, the file has " << static_cast<int64_t>(available)
+                     << " (" << room << ")";
     }
   }
 
@@ -440,6 +505,9 @@ TriangleMesh ReadPly(const std::string& path) {
 
   BodyReader reader(path, data, header.body_offset, header.format);
   std::vector<double> record_values;
+  // ASCII: the first vertex record that does not end its line (-1: none),
+  // the sign of a header that claims more vertices than the file holds.
+  int64_t first_unended_vertex = -1;
   for (size_t e = 0; e < header.elements.size(); ++e) {
     const Element& element = header.elements[e];
     const int64_t fixed_size = element.FixedSize();
@@ -488,47 +556,68 @@ TriangleMesh ReadPly(const std::string& path) {
           mesh.C(i, 2) = ToColor(record_values[layout.blue], element.properties[layout.blue].type);
         }
         if (has_values) mesh.values(i) = record_values[layout.value];
+        if (!reader.binary() && first_unended_vertex < 0 && !reader.AtLineEnd()) {
+          first_unended_vertex = i;
+        }
       }
     } else if (static_cast<int>(e) == face_element) {
       triangles.reserve(element.count * 3);
       int corners[3];
-      for (int64_t i = 0; i < element.count; ++i) {
-        for (size_t k = 0; k < element.properties.size(); ++k) {
-          const Property& prop = element.properties[k];
-          if (!prop.is_list) {
-            reader.Read(prop.type, element, i);
-            continue;
-          }
-          const double n_value = reader.Read(prop.count_type, element, i);
-          if (n_value < 0) {
-            MR_THROW_INPUT << path << ": negative list length " << n_value << " in face " << i;
-          }
-          const int64_t n = static_cast<int64_t>(n_value);
-          if (static_cast<int>(k) != face_list) {
-            for (int64_t j = 0; j < n; ++j) reader.Read(prop.type, element, i);
-            continue;
-          }
-          if (n < 3) {
-            MR_THROW_INPUT << path << ": face " << i << " has " << n
-                           << " corners (expected at least 3)";
-          }
-          for (int64_t j = 0; j < n; ++j) {
-            const double index = reader.Read(prop.type, element, i);
-            if (index < 0 || index >= static_cast<double>(num_vertices)) {
-              MR_THROW_INPUT << path << ": face " << i << " has vertex index " << index
-                             << " out of range [0, " << num_vertices << ")";
+      const size_t face_begin = reader.offset();
+      try {
+        for (int64_t i = 0; i < element.count; ++i) {
+          for (size_t k = 0; k < element.properties.size(); ++k) {
+            const Property& prop = element.properties[k];
+            if (!prop.is_list) {
+              reader.Read(prop.type, element, i);
+              continue;
             }
-            const int v = static_cast<int>(index);
-            // Fan triangulation: (c0, c_{j-1}, c_j) for j >= 2.
-            if (j < 2) {
-              corners[j] = v;
-            } else {
-              corners[2] = v;
-              triangles.insert(triangles.end(), corners, corners + 3);
-              corners[1] = v;
+            const double n_value = reader.Read(prop.count_type, element, i);
+            if (n_value < 0) {
+              MR_THROW_INPUT << path << ": negative list length " << n_value << " in face " << i;
+            }
+            const int64_t n = static_cast<int64_t>(n_value);
+            if (static_cast<int>(k) != face_list) {
+              for (int64_t j = 0; j < n; ++j) reader.Read(prop.type, element, i);
+              continue;
+            }
+            if (n < 3) {
+              MR_THROW_INPUT << path << ": face " << i << " has " << n
+                             << " corners (expected at least 3)";
+            }
+            for (int64_t j = 0; j < n; ++j) {
+              const double index = reader.Read(prop.type, element, i);
+              if (index < 0 || index >= static_cast<double>(num_vertices)) {
+                MR_THROW_INPUT << path << ": face " << i << " has vertex index " << index
+                               << " out of range [0, " << num_vertices << ")";
+              }
+              const int v = static_cast<int>(index);
+              // Fan triangulation: (c0, c_{j-1}, c_j) for j >= 2.
+              if (j < 2) {
+                corners[j] = v;
+              } else {
+                corners[2] = v;
+                triangles.insert(triangles.end(), corners, corners + 3);
+                corners[1] = v;
+              }
             }
           }
         }
+      } catch (const InputError&) {
+        // Faces that do not read may be faces read from the wrong place.
+        int64_t held = -1;
+        if (reader.binary()) {
+          held = VerticesBeforeFaces(data, header, vertex_element, face_element, face_list,
+                                     face_begin, reader.swap());
+        } else if (static_cast<int>(e) == vertex_element + 1) {
+          held = first_unended_vertex;
+        }
+        if (held >= 0) {
+          MR_THROW_INPUT << path << ": the header claims more vertices than the file holds: "
+                         << "the vertices end after vertex " << held << " of " << vertex.count
+                         << " and the " << element.count << " faces follow";
+        }
+        throw;
       }
     } else {
       // Skip an element we do not use.

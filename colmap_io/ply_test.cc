@@ -306,6 +306,27 @@ TEST(PlyBadInput, TruncatedFile) {
   }
 }
 
+// A header whose vertex count is larger than the file holds: the faces are
+// then read from the wrong place ("face 0 has 0 corners" in binary). The
+// message must say what is wrong.
+TEST(PlyBadInput, HeaderClaimsMoreVertices) {
+  const TriangleMesh mesh = MakeMesh(false, false, false);  // 5 vertices, 4 faces
+  for (PlyFormat format :
+       {PlyFormat::kBinaryLittleEndian, PlyFormat::kBinaryBigEndian, PlyFormat::kAscii}) {
+    const std::string path = TempPath("more_vertices.ply");
+    WritePly(path, mesh, format);
+    std::string data = ReadRaw(path);
+    const size_t at = data.find("element vertex 5\n");
+    ASSERT_NE(at, std::string::npos);
+    WriteRaw(path, data.substr(0, at) + "element vertex 6\n" + data.substr(at + 17));
+    ExpectInputError([&] { ReadPly(path); },
+                     {path, "claims more vertices than the file holds", "end after vertex 5 of 6"});
+    // Far more than the file can hold.
+    WriteRaw(path, data.substr(0, at) + "element vertex 500\n" + data.substr(at + 17));
+    ExpectInputError([&] { ReadPly(path); }, {path, "truncated PLY body", "vertex", "of 500"});
+  }
+}
+
 TEST(PlyBadInput, MissingCoordinate) {
   const std::string path = TempPath("missing_z.ply");
   WriteRaw(path,

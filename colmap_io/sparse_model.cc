@@ -56,10 +56,14 @@ void CheckCamera(const std::string& path, int model_id, const Camera& camera) {
   for (size_t i = 0; i < camera.params.size(); ++i) {
     CheckFinite(path, camera.params[i], where + " parameter " + std::to_string(i));
   }
-  if (CameraFocalX(camera.model, camera.params) <= 0 ||
-      CameraFocalY(camera.model, camera.params) <= 0) {
-    MR_THROW_INPUT << path << ": " << where << " has a non-positive focal length ("
-                   << camera.params[0] << ")";
+  const bool separate = HasSeparateFocalLengths(camera.model);
+  const double fx = CameraFocalX(camera.model, camera.params);
+  const double fy = CameraFocalY(camera.model, camera.params);
+  if (fx <= 0 || fy <= 0) {
+    const char* name = !separate ? "f" : fx <= 0 ? "fx" : "fy";
+    MR_THROW_INPUT << path << ": " << where << " (" << CameraModelName(camera.model)
+                   << ") has a non-positive focal length " << name << " = "
+                   << (fx <= 0 ? fx : fy) << " (expected > 0)";
   }
 }
 

@@ -358,5 +358,16 @@ TEST(SparseModel, BadSizeAndFocal) {
   ExpectInputError([&] { ReadSparseModelText(dir.path()); }, {"cameras.txt:1", "focal"});
 }
 
+// The message names the focal length that is wrong, with its value.
+TEST(SparseModel, NonPositiveFocalIsNamed) {
+  TempDir dir("sparse_bad_focal");
+  WriteString(dir.path() + "/cameras.txt", "1 PINHOLE 640 480 576 -576 320 240\n");
+  ExpectInputError([&] { ReadSparseModelText(dir.path()); }, {"cameras.txt:1", "fy = -576"});
+  WriteString(dir.path() + "/cameras.txt", "1 PINHOLE 640 480 0 576 320 240\n");
+  ExpectInputError([&] { ReadSparseModelText(dir.path()); }, {"cameras.txt:1", "fx = 0"});
+  WriteString(dir.path() + "/cameras.txt", "1 SIMPLE_RADIAL 640 480 -576 320 240 0\n");
+  ExpectInputError([&] { ReadSparseModelText(dir.path()); }, {"cameras.txt:1", "f = -576"});
+}
+
 }  // namespace
 }  // namespace mr

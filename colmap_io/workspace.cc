@@ -159,7 +159,16 @@ Workspace OpenWorkspaceImpl(const std::string& path, const WorkspaceOptions& opt
 
   std::vector<std::string> missing;
   for (const auto& [id, image] : model.images) {
-    if (!ExistsFile(JoinPaths(image_dir, image.name))) missing.push_back(image.name);
+    const std::string image_path = JoinPaths(image_dir, image.name);
+    if (ExistsFile(image_path)) continue;
+    std::error_code ec;
+    if (fs::exists(image_path, ec)) {
+      MR_THROW_INPUT << image_path << ": image " << id << " of the sparse model " << sparse_dir
+                     << " is not a file ("
+                     << (ExistsDir(image_path) ? "a folder" : "not a regular file")
+                     << "; expected an image file)";
+    }
+    missing.push_back(image.name);
   }
   if (!missing.empty()) {
     std::sort(missing.begin(), missing.end());
@@ -224,8 +233,9 @@ MaskCheck CheckMasks(const std::string& mask_dir, const Reconstruction& model) {
     const std::vector<std::string> files = ListFiles(mask_dir);
     MR_THROW_INPUT << mask_dir << ": no mask matches the images; expected <image name>.png such as "
                    << names.front() << ".png, found "
-                   << (files.empty() ? "no files" : std::to_string(files.size()) +
-                                                        " files such as " + Examples(files))
+                   << (files.empty()
+                           ? "no files"
+                           : std::to_string(files.size()) + " files such as " + Examples(files))
                    << " (COLMAP's naming: images/a.jpg -> masks/a.jpg.png)";
   }
   return check;

@@ -85,11 +85,11 @@ std::string Encode(const std::string& ext, const cv::Mat& image) {
 // Orientation = `orientation` inserted right after SOI, as cameras write it.
 std::string JpegWithExifOrientation(const cv::Mat& image, int orientation) {
   const std::string jpeg = Encode(".jpg", image);
-  std::string tiff("II*\0\x08\0\0\0", 8);          // little-endian TIFF header, IFD at 8
-  tiff += std::string("\x01\0", 2);                  // 1 entry
+  std::string tiff("II*\0\x08\0\0\0", 8);              // little-endian TIFF header, IFD at 8
+  tiff += std::string("\x01\0", 2);                    // 1 entry
   tiff += std::string("\x12\x01\x03\0\x01\0\0\0", 8);  // tag 0x0112 SHORT, count 1
   tiff += std::string(1, static_cast<char>(orientation)) + std::string(3, '\0');
-  tiff += std::string(4, '\0');                       // no next IFD
+  tiff += std::string(4, '\0');                         // no next IFD
   const std::string payload = std::string("Exif\0\0", 6) + tiff;
   const size_t length = payload.size() + 2;
   std::string app1 = "\xff\xe1";
@@ -301,6 +301,23 @@ TEST(Workspace, MissingImages) {
   ExpectInputError([&] { OpenWorkspace(root); }, {"2 of 3 images", "a.png", "sub/b.png"});
 }
 
+// An image path that exists but is a folder is "not a file", not "missing".
+TEST(Workspace, ImagePathIsAFolder) {
+  TempDir dir("ws_image_folder");
+  const std::string root = MakeWorkspace(dir, PinholeModel(), "sparse");
+  fs::remove(root + "/images/a.png");
+  fs::create_directories(root + "/images/a.png");
+  try {
+    OpenWorkspace(root);
+    ADD_FAILURE() << "no InputError thrown";
+  } catch (const InputError& e) {
+    const std::string what = e.what();
+    EXPECT_NE(what.find(root + "/images/a.png"), std::string::npos) << what;
+    EXPECT_NE(what.find("not a file"), std::string::npos) << what;
+    EXPECT_EQ(what.find("missing"), std::string::npos) << what;
+  }
+}
+
 TEST(Workspace, ZeroRegisteredImages) {
   TempDir dir("ws_zero_images");
   Reconstruction model = PinholeModel();
@@ -368,7 +385,8 @@ TEST(Workspace, TruncatedImagesAreRefused) {
   cv::Mat noise(48, 64, CV_8UC3);
   cv::randu(noise, cv::Scalar::all(0), cv::Scalar::all(255));
   const std::string jpeg = Encode(".jpg", noise), png = Encode(".png", noise);
-  for (const std::string& bytes : {jpeg.substr(0, jpeg.size() / 2), png.substr(0, png.size() / 2)}) {
+  for (const std::string& bytes :
+       {jpeg.substr(0, jpeg.size() / 2), png.substr(0, png.size() / 2)}) {
     TempDir dir("ws_truncated");
     const std::string root = MakeWorkspace(dir, PinholeModel(), "sparse");
     WriteBytes(root + "/images/a.png", bytes);
@@ -394,7 +412,8 @@ TEST(Workspace, TruncatedImagesAreRefused) {
         {masks + "/a.png.png", "truncated or corrupt image"});
   }
   // Undistortion of a sparse project reads them too.
-  for (const std::string& bytes : {jpeg.substr(0, jpeg.size() / 2), png.substr(0, png.size() / 2)}) {
+  for (const std::string& bytes :
+       {jpeg.substr(0, jpeg.size() / 2), png.substr(0, png.size() / 2)}) {
     TempDir dir("ws_truncated_distorted");
     const std::string root = MakeWorkspace(dir, DistortedModel(), "sparse/0");
     WriteBytes(root + "/images/sub/b.png", bytes);
@@ -409,8 +428,9 @@ TEST(Workspace, CompleteImagesWithTrailingBytesAreRead) {
   cv::Mat noise(48, 64, CV_8UC3);
   cv::randu(noise, cv::Scalar::all(0), cv::Scalar::all(255));
   const std::string jpeg = Encode(".jpg", noise), png = Encode(".png", noise);
-  for (const std::string& bytes : {jpeg + std::string(100, '\0'), jpeg + "appended data",
-                                   png + std::string(16, '\0'), JpegWithExifOrientation(noise, 1)}) {
+  for (const std::string& bytes :
+       {jpeg + std::string(100, '\0'), jpeg + "appended data", png + std::string(16, '\0'),
+        JpegWithExifOrientation(noise, 1)}) {
     TempDir dir("ws_trailing");
     const std::string root = MakeWorkspace(dir, PinholeModel(), "sparse");
     WriteBytes(root + "/images/a.png", bytes);
@@ -433,7 +453,8 @@ TEST(Workspace, MasksMatchingNoImageAreAnError) {
     }
     ExpectInputError([&] { OpenWorkspace(root); },
                      {masks, "no mask matches the images",
-                      "expected <image name>.png such as a.png.png", "found 2 files such as a.png"});
+                      "expected <image name>.png such as a.png.png",
+                      "found 2 files such as a.png"});
     // A program that uses only the cameras does not look at masks.
     WorkspaceOptions options;
     options.use_masks = false;
@@ -451,7 +472,8 @@ TEST(Workspace, CheckMasks) {
   MaskCheck check = CheckMasks(masks, model);
   EXPECT_EQ(check.num_images, 3);
   EXPECT_EQ(check.missing, (std::vector<std::string>{"c.png"}));
-  EXPECT_EQ(check.empty, (std::vector<std::string>{masks + "/a.png.png", masks + "/sub/b.png.png"}));
+  EXPECT_EQ(check.empty,
+            (std::vector<std::string>{masks + "/a.png.png", masks + "/sub/b.png.png"}));
   cv::Mat one(48, 64, CV_8UC1, cv::Scalar(0));
   one.at<uint8_t>(47, 63) = 1;  // a single foreground pixel is enough
   ASSERT_TRUE(cv::imwrite(masks + "/a.png.png", one));
