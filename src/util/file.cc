@@ -80,6 +80,47 @@ std::vector<std::string> ReadNameList(const std::string& path) {
   return names;
 }
 
+namespace {
+
+// Absolute, normalized, with the symbolic links of its existing part
+// resolved and no trailing separator.
+fs::path Resolve(const std::string& path) {
+  std::error_code ec;
+  fs::path p = fs::weakly_canonical(fs::absolute(path, ec), ec);
+  if (ec) p = fs::absolute(path).lexically_normal();
+  if (p.filename().empty() && p.has_parent_path()) p = p.parent_path();
+  return p;
+}
+
+bool IsInside(const fs::path& path, const fs::path& dir) {
+  auto p = path.begin();
+  for (auto d = dir.begin(); d != dir.end(); ++d, ++p) {
+    if (p == path.end() || *p != *d) return false;
+  }
+  return p != path.end();
+}
+
+}  // namespace
+
+void RefuseOutputOverInput(const std::string& what, const std::string& output,
+                           const std::vector<std::string>& inputs) {
+  if (output.empty()) return;
+  const fs::path out = Resolve(output);
+  for (const std::string& input : inputs) {
+    if (input.empty()) continue;
+    const fs::path in = Resolve(input);
+    std::error_code ec;
+    if (out == in || fs::equivalent(output, input, ec)) {
+      MR_THROW_INPUT << what << " " << output << ": is the input " << input
+                     << "; refusing to overwrite an input";
+    }
+    if (fs::is_directory(in, ec) && IsInside(out, in)) {
+      MR_THROW_INPUT << what << " " << output << ": is inside the input folder " << input
+                     << "; refusing to overwrite inputs";
+    }
+  }
+}
+
 void WriteFileAtomically(const std::string& path,
                          const std::function<void(std::ostream&)>& write) {
   const fs::path target(path);

@@ -27,6 +27,16 @@ std::string ReadFileToString(const std::string& path);
 // name lists such as holdout.txt). Throws InputError if it cannot be read.
 std::vector<std::string> ReadNameList(const std::string& path);
 
+// Refuses, before any work, an output that would replace or write into an
+// input: throws InputError "<what> <output>: is the input <input>; refusing
+// to overwrite an input" if `output` resolves to one of `inputs` (relative
+// paths, "." and "..", symbolic links; a hard link to the same file), or
+// "...: is inside the input folder <input>; ..." if it lies inside one of
+// them that is an existing folder. Empty entries of `inputs` are ignored;
+// inputs need not exist. `what` names the output ("--output_path").
+void RefuseOutputOverInput(const std::string& what, const std::string& output,
+                           const std::vector<std::string>& inputs);
+
 // Writes a file atomically: `write` fills a temporary file in the same folder
 // (opened in binary mode as `path + ".tmp.<pid>"`), which is renamed onto
 // `path` only if `write` returns without throwing and the stream is good. On

@@ -115,6 +115,10 @@ bool OptionManager::WasSet(const std::string& name) const {
   return it != entries_.end() && it->second.set;
 }
 
+void OptionManager::SetInputPaths(std::function<std::vector<std::string>()> inputs) {
+  input_paths_ = std::move(inputs);
+}
+
 void OptionManager::Set(const std::string& name, const std::string& value,
                         const std::string& origin) {
   auto it = entries_.find(name);
@@ -229,6 +233,19 @@ bool OptionManager::Parse(int argc, char** argv) {
   if (!config_path.empty()) ReadConfig(config_path);
   for (const auto& [name, value] : flags) Set(name, value, "command line");
   if (!write_config.empty()) {
+    std::vector<std::string> inputs = {config_path};
+    for (const auto& name : order_) {
+      const Entry& e = entries_.at(name);
+      const bool is_path = e.type == "string" && name.size() > 5 &&
+                           name.compare(name.size() - 5, 5, "_path") == 0;
+      if (is_path && name.rfind("output", 0) != 0 && !ExistsDir(e.print())) {
+        inputs.push_back(e.print());
+      }
+    }
+    if (input_paths_) {
+      for (const std::string& path : input_paths_()) inputs.push_back(path);
+    }
+    RefuseOutputOverInput("--write_config", write_config, inputs);
     WriteConfig(write_config);
     return false;
   }

@@ -10,7 +10,10 @@
 // Flags are `--name value` or `--name=value`. A name "Section.field" maps to
 // the key `field` under `[Section]` in an .ini file given with
 // `--config_path FILE` (read first; flags on the command line override it).
-// `--write_config FILE` writes the effective options and exits. Booleans take
+// `--write_config FILE` writes the effective options and exits; it refuses
+// (InputError) a FILE that resolves to an input: --config_path, the value of
+// any "*_path" option that is not an output ("output_*") or a folder, and
+// whatever SetInputPaths returns. Booleans take
 // 1/0/true/false, or no value (meaning true). `-h`/`--help` prints usage.
 
 #include <functional>
@@ -44,6 +47,11 @@ class OptionManager {
   // True if the option was given on the command line or in a config file.
   bool WasSet(const std::string& name) const;
 
+  // The files and folders (whose whole content is input) that the program
+  // reads, computed from the parsed options; --write_config may not resolve
+  // to or into any of them. Called by Parse after the options are set.
+  void SetInputPaths(std::function<std::vector<std::string>()> inputs);
+
  private:
   struct Entry {
     std::string help;
@@ -61,6 +69,7 @@ class OptionManager {
   std::string description_;
   std::vector<std::string> order_;
   std::map<std::string, Entry> entries_;
+  std::function<std::vector<std::string>()> input_paths_;
 };
 
 }  // namespace mr

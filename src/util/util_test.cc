@@ -37,6 +37,40 @@ TEST(WriteFileAtomically, MissingFolder) {
                InputError);
 }
 
+TEST(RefuseOutputOverInput, SameFileHoweverSpelled) {
+  namespace fs = std::filesystem;
+  const std::string dir = MakeTestDir("refuse");
+  const std::string m = JoinPaths(dir, "m.ply");
+  WriteFileAtomically(m, [](std::ostream& out) { out << "mesh"; });
+  fs::create_directories(JoinPaths(dir, "sub"));
+  fs::create_symlink(m, JoinPaths(dir, "link.ply"));
+  fs::create_hard_link(m, JoinPaths(dir, "hard.ply"));
+  fs::create_directory_symlink(dir, JoinPaths(dir, "sub/up"));
+  for (const std::string& output :
+       {m, dir + "/./m.ply", dir + "/sub/../m.ply", dir + "/link.ply", dir + "/hard.ply",
+        dir + "/sub/up/m.ply", dir + "//m.ply"}) {
+    ExpectInputError([&] { RefuseOutputOverInput("--output_path", output, {"", m}); },
+                     {"--output_path " + output, "is the input " + m, "refusing to overwrite"});
+  }
+  // A relative output against an absolute input.
+  const fs::path cwd = fs::current_path();
+  fs::current_path(JoinPaths(dir, "sub"));
+  ExpectInputError([&] { RefuseOutputOverInput("--write_config", "../m.ply", {m}); },
+                   {"--write_config ../m.ply", "is the input"});
+  fs::current_path(cwd);
+  // Inside an input folder, at any depth; inputs that do not exist yet.
+  ExpectInputError([&] { RefuseOutputOverInput("--write_config", dir + "/sub/a.ini", {dir}); },
+                   {"inside the input folder " + dir});
+  ExpectInputError(
+      [&] { RefuseOutputOverInput("--output_path", dir + "/new.ply", {dir + "/new.ply"}); },
+      {"is the input"});
+  // Other paths pass: a sibling, a name that only starts like the folder.
+  RefuseOutputOverInput("--output_path", dir + "/out.ply", {m, dir + "/sub"});
+  RefuseOutputOverInput("--output_path", dir + "/sub2/x.ply", {dir + "/sub"});
+  RefuseOutputOverInput("--output_path", dir + "/m.ply.bak", {m});
+  RefuseOutputOverInput("--output_path", "", {m});
+}
+
 TEST(ReadNameList, SkipsBlankLinesAndComments) {
   const std::string path = JoinPaths(MakeTestDir("names"), "list.txt");
   WriteFileAtomically(path, [](std::ostream& out) { out << "# held out\n a.png \n\nb c.png\r\n"; });
@@ -85,6 +119,45 @@ TEST(OptionManager, FlagsConfigAndOverride) {
   EXPECT_EQ(iterations2, 7);
   EXPECT_DOUBLE_EQ(step2, 0.125);
   EXPECT_EQ(path2, "/ws");
+}
+
+// --write_config never replaces an input: the config it read, a *_path
+// option's file, or what the program names with SetInputPaths.
+TEST(OptionManager, WriteConfigOverAnInputIsRefused) {
+  const std::string dir = MakeTestDir("options_inputs");
+  const std::string ini = JoinPaths(dir, "a.ini"), mesh = JoinPaths(dir, "m.ply");
+  const std::string model = JoinPaths(dir, "sparse");
+  WriteFileAtomically(ini, [](std::ostream& out) { out << "n = 2\n"; });
+  WriteFileAtomically(mesh, [](std::ostream& out) { out << "mesh"; });
+  CreateDirIfNotExists(model);
+  auto parse = [&](std::vector<std::string> args) {
+    int n = 0;
+    std::string input_path, output_path, workspace_path;
+    OptionManager options("prog", "test");
+    options.Add("n", &n, "n");
+    options.Add("input_path", &input_path, "in");
+    options.Add("output_path", &output_path, "out");
+    options.Add("workspace_path", &workspace_path, "ws");
+    options.SetInputPaths(
+        [&] { return std::vector<std::string>{JoinPaths(workspace_path, "sparse")}; });
+    args.insert(args.begin(), "prog");
+    std::vector<char*> argv;
+    for (std::string& a : args) argv.push_back(&a[0]);
+    return options.Parse(static_cast<int>(argv.size()), argv.data());
+  };
+  ExpectInputError([&] { parse({"--config_path", ini, "--write_config", ini}); },
+                   {"--write_config " + ini, "is the input", "refusing to overwrite"});
+  ExpectInputError([&] { parse({"--input_path", mesh, "--write_config", mesh}); },
+                   {"--write_config " + mesh, "is the input " + mesh});
+  ExpectInputError(
+      [&] { parse({"--workspace_path", dir, "--write_config", model + "/cameras.bin"}); },
+      {"inside the input folder " + model});
+  EXPECT_EQ(ReadFileToString(ini), "n = 2\n");
+  EXPECT_EQ(ReadFileToString(mesh), "mesh");
+  // Beside the inputs, in the workspace folder, or at the output path: written.
+  EXPECT_FALSE(parse({"--input_path", mesh, "--workspace_path", dir, "--output_path",
+                      JoinPaths(dir, "b.ini"), "--write_config", JoinPaths(dir, "b.ini")}));
+  EXPECT_NE(ReadFileToString(JoinPaths(dir, "b.ini")).find("input_path="), std::string::npos);
 }
 
 TEST(OptionManager, BadInput) {
