@@ -146,13 +146,19 @@ TriangleMesh ReadObj(const std::string& path) {
 void WriteObj(const std::string& path, const TriangleMesh& mesh) {
   const Eigen::Index nv = mesh.V.rows();
   const bool has_normals = mesh.N.rows() == nv && mesh.N.cols() == 3 && nv > 0;
+  const bool has_colors = mesh.C.rows() == nv && nv > 0;
   std::string body;
   body.reserve(nv * 48 + mesh.F.rows() * 32);
   body += "# written by mesh_refiner\n";
   char line[160];
   for (Eigen::Index i = 0; i < nv; ++i) {
-    const int n = std::snprintf(line, sizeof(line), "v %.17g %.17g %.17g\n", mesh.V(i, 0),
-                                mesh.V(i, 1), mesh.V(i, 2));
+    const int n =
+        has_colors
+            ? std::snprintf(line, sizeof(line), "v %.17g %.17g %.17g %.9g %.9g %.9g\n",
+                            mesh.V(i, 0), mesh.V(i, 1), mesh.V(i, 2), mesh.C(i, 0) / 255.0,
+                            mesh.C(i, 1) / 255.0, mesh.C(i, 2) / 255.0)
+            : std::snprintf(line, sizeof(line), "v %.17g %.17g %.17g\n", mesh.V(i, 0),
+                            mesh.V(i, 1), mesh.V(i, 2));
     body.append(line, n);
   }
   if (has_normals) {

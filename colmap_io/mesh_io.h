@@ -19,8 +19,9 @@ namespace mr {
 TriangleMesh ReadMesh(const std::string& path);
 
 // Writes a .ply (binary little-endian) or .obj mesh atomically. OBJ output
-// holds positions, faces, and per-vertex normals (`vn`, faces as v//vn) when
-// mesh.N is non-empty.
+// holds positions, faces, per-vertex normals (`vn`, faces as v//vn) when
+// mesh.N is non-empty, and vertex colours (`v x y z r g b`, r g b in [0, 1])
+// when mesh.C is non-empty.
 void WriteMesh(const std::string& path, const TriangleMesh& mesh);
 
 TriangleMesh ReadObj(const std::string& path);

@@ -52,6 +52,20 @@ TEST(MeshIo, ObjRoundTripWithNormals) {
   EXPECT_TRUE(read.F == mesh.F);
 }
 
+// Vertex colours (mesh_refiner's output has them) survive an OBJ round trip.
+TEST(MeshIo, ObjRoundTripWithColors) {
+  TriangleMesh mesh = Tetrahedron();
+  mesh.C.resize(4, 3);
+  mesh.C << 0, 1, 2, 127, 128, 129, 253, 254, 255, 10, 200, 30;
+  const std::string path = TempPath("tet_colors.obj");
+  WriteMesh(path, mesh);
+  const TriangleMesh read = ReadMesh(path);
+  EXPECT_TRUE(read.V == mesh.V);
+  EXPECT_TRUE(read.F == mesh.F);
+  ASSERT_EQ(read.C.rows(), 4);
+  EXPECT_TRUE(read.C == mesh.C);
+}
+
 TEST(MeshIo, PlyRoundTripThroughDispatch) {
   const TriangleMesh mesh = Tetrahedron();
   const std::string path = TempPath("tet.PLY");  // extension is case-insensitive

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <filesystem>
+#include <set>
 
 #include <opencv2/imgcodecs.hpp>
 
@@ -210,6 +211,37 @@ bool WorkspaceOptions::Check() const { return true; }
 Workspace OpenWorkspace(const std::string& path, const WorkspaceOptions& options) {
   options.Check();
   return OpenWorkspaceImpl(path, options, /*check_masks=*/true);
+}
+
+void CheckImageNamesInModel(const Workspace& workspace, const std::vector<std::string>& names,
+                            const std::string& list_path) {
+  std::set<std::string> registered;
+  for (const auto& [id, image] : workspace.model.images) registered.insert(image.name);
+  std::vector<std::string> unknown;
+  for (const std::string& name : names) {
+    if (!registered.count(name)) unknown.push_back(name);
+  }
+  if (unknown.empty()) return;
+  MR_THROW_INPUT << list_path << ": " << unknown.size() << " of " << names.size()
+                 << " image names are not in the sparse model " << workspace.sparse_dir << ": "
+                 << Examples(unknown, 5) << " (expected names as the model has them, e.g. "
+                 << (registered.empty() ? std::string("none") : *registered.begin()) << ")";
+}
+
+std::vector<std::string> WorkspaceInputPaths(const std::string& path,
+                                             const WorkspaceOptions& options) {
+  if (path.empty()) return {};
+  std::vector<std::string> inputs = {
+      options.image_path.empty() ? JoinPaths(path, "images") : options.image_path,
+      JoinPaths(path, "sparse"), JoinPaths(path, kUndistortedFolder),
+      JoinPaths(path, "meshed-poisson.ply"), JoinPaths(path, "meshed-delaunay.ply")};
+  if (options.use_masks) {
+    for (const std::string& dir : {options.mask_path, JoinPaths(path, "masks"),
+                                   JoinPaths(path, "stereo/masks")}) {
+      if (!dir.empty()) inputs.push_back(dir);
+    }
+  }
+  return inputs;
 }
 
 MaskCheck CheckMasks(const std::string& mask_dir, const Reconstruction& model) {

@@ -67,6 +67,19 @@ struct Workspace {
 // background are logged as warnings (see CheckMasks).
 Workspace OpenWorkspace(const std::string& path, const WorkspaceOptions& options = {});
 
+// Throws InputError "<list_path>: N image names are not in the sparse model
+// ...: a.png, ..." if any of `names` (read from the file `list_path`, such
+// as a --holdout_path list) is not the name of an image of the model.
+void CheckImageNamesInModel(const Workspace& workspace, const std::vector<std::string>& names,
+                            const std::string& list_path);
+
+// The files and folders of the workspace at `path` that the programs read,
+// for RefuseOutputOverInput, without opening it: the image folder, sparse/
+// (every model in it), the mask folders, mesh_refiner_undistorted/, and the
+// default meshes meshed-poisson.ply and meshed-delaunay.ply. Not all exist.
+std::vector<std::string> WorkspaceInputPaths(const std::string& path,
+                                             const WorkspaceOptions& options = {});
+
 // What CheckMasks found in a mask folder.
 struct MaskCheck {
   int num_images = 0;                // images in the model

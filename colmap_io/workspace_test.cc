@@ -462,6 +462,42 @@ TEST(Workspace, MasksMatchingNoImageAreAnError) {
   }
 }
 
+TEST(Workspace, CheckImageNamesInModel) {
+  TempDir dir("ws_names");
+  const Workspace ws = OpenWorkspace(MakeWorkspace(dir, PinholeModel(), "sparse"));
+  CheckImageNamesInModel(ws, {"a.png", "sub/b.png"}, "holdout.txt");
+  CheckImageNamesInModel(ws, {}, "holdout.txt");
+  ExpectInputError(
+      [&] { CheckImageNamesInModel(ws, {"a.png", "b.png", "x.jpg"}, "holdout.txt"); },
+      {"holdout.txt: 2 of 3 image names are not in the sparse model", "b.png, x.jpg",
+       "e.g. a.png"});
+}
+
+TEST(Workspace, InputPaths) {
+  TempDir dir("ws_input_paths");
+  const std::string root = MakeWorkspace(dir, PinholeModel(), "sparse");
+  dir.Sub("masks");
+  dir.Sub("mesh_refiner_undistorted/sparse");
+  const std::vector<std::string> inputs = WorkspaceInputPaths(root);
+  for (const std::string& output :
+       {root + "/images/a.png", root + "/sparse/cameras.bin", root + "/sparse/0/images.txt",
+        root + "/meshed-poisson.ply", root + "/masks/a.png.png",
+        root + "/mesh_refiner_undistorted/sparse/cameras.bin"}) {
+    ExpectInputError([&] { RefuseOutputOverInput("--output_path", output, inputs); },
+                     {output, "refusing to overwrite"});
+  }
+  RefuseOutputOverInput("--output_path", root + "/meshed-refined.ply", inputs);
+  RefuseOutputOverInput("--write_config", root + "/refine.ini", inputs);
+  WorkspaceOptions options;
+  options.image_path = dir.Sub("elsewhere");
+  options.use_masks = false;
+  const std::vector<std::string> custom = WorkspaceInputPaths(root, options);
+  ExpectInputError(
+      [&] { RefuseOutputOverInput("--output_path", options.image_path + "/x.ply", custom); },
+      {"inside the input folder"});
+  RefuseOutputOverInput("--output_path", root + "/masks/a.png.png", custom);
+}
+
 TEST(Workspace, CheckMasks) {
   TempDir dir("ws_check_masks");
   const Reconstruction model = PinholeModel();
