@@ -10,6 +10,7 @@
 
 #include <opencv2/imgcodecs.hpp>
 
+#include "colmap_io/mesh_io.h"
 #include "colmap_io/ply.h"
 #include "colmap_io/sparse_model.h"
 #include "geometry/mesh.h"
@@ -189,6 +190,94 @@ TEST_F(MeshRefinerCli, RefusesToOverwriteInput) {
                                      dir_ + "/meshed-poisson.ply" + kFast);
   EXPECT_NE(r.exit_code, 0);
   EXPECT_NE(r.output.find("refusing to overwrite"), std::string::npos) << r.output;
+}
+
+// A refused run: exit code 1, one ERROR line with `message`, and `kept` (an
+// existing file) byte-identical afterwards, no temporary file left.
+void ExpectRefused(const CommandResult& r, const std::string& message, const std::string& kept,
+                   const std::string& kept_bytes) {
+  EXPECT_EQ(r.exit_code, 1) << r.output;
+  EXPECT_NE(r.output.find("ERROR: "), std::string::npos) << r.output;
+  EXPECT_NE(r.output.find(message), std::string::npos) << r.output;
+  EXPECT_TRUE(ReadFileToString(kept) == kept_bytes) << kept << " was changed";
+  for (const auto& name : ListFiles(GetParentDir(kept))) {
+    EXPECT_EQ(name.find(".tmp."), std::string::npos) << name;
+  }
+}
+
+// --write_config must never replace an input: the mesh (given or the
+// default one), the sparse model, an image, however the path is spelled.
+TEST_F(MeshRefinerCli, WriteConfigOverAnInputIsRefused) {
+  const std::string mesh = dir_ + "/meshed-poisson.ply";
+  const std::string mesh_bytes = ReadFileToString(mesh);
+  ExpectRefused(RunCommand(kRefiner + " --workspace_path " + dir_ + " --input_path " + mesh +
+                           " --write_config " + mesh),
+                "refusing to overwrite", mesh, mesh_bytes);
+  ExpectRefused(RunCommand(kRefiner + " --workspace_path " + dir_ + " --write_config " + mesh),
+                "refusing to overwrite", mesh, mesh_bytes);
+  ExpectRefused(RunCommand("cd " + dir_ + "/images && " + kRefiner + " --workspace_path " + dir_ +
+                           " --write_config ../images/../meshed-poisson.ply"),
+                "refusing to overwrite", mesh, mesh_bytes);
+  fs::create_symlink(mesh, dir_ + "/link.ply");
+  ExpectRefused(RunCommand(kRefiner + " --workspace_path " + dir_ + " --input_path " + dir_ +
+                           "/link.ply --write_config " + mesh),
+                "refusing to overwrite", mesh, mesh_bytes);
+  const std::string cameras = dir_ + "/sparse/cameras.bin";
+  const std::string cameras_bytes = ReadFileToString(cameras);
+  ExpectRefused(RunCommand(kRefiner + " --workspace_path " + dir_ + " --write_config " + cameras),
+                "refusing to overwrite", cameras, cameras_bytes);
+  const std::string image = dir_ + "/images/view_0.png";
+  const std::string image_bytes = ReadFileToString(image);
+  ExpectRefused(RunCommand(kRefiner + " --workspace_path " + dir_ + " --write_config " + image),
+                "refusing to overwrite", image, image_bytes);
+  // Elsewhere it is written.
+  const CommandResult r =
+      RunCommand(kRefiner + " --workspace_path " + dir_ + " --write_config " + dir_ + "/a.ini");
+  EXPECT_EQ(r.exit_code, 0) << r.output;
+  EXPECT_NE(ReadFileToString(dir_ + "/a.ini").find("[Refine]"), std::string::npos);
+}
+
+// The mesh output may not land on the model or images either, and its
+// extension must be one that is written (.ply, .obj); refused before the
+// workspace is read.
+TEST_F(MeshRefinerCli, OutputOverAnInputOrWithAnUnknownExtensionIsRefused) {
+  const std::string cameras = dir_ + "/sparse/cameras.bin";
+  const std::string cameras_bytes = ReadFileToString(cameras);
+  ExpectRefused(RunCommand(kRefiner + " --workspace_path " + dir_ + " --output_path " + cameras +
+                           kFast),
+                "refusing to overwrite", cameras, cameras_bytes);
+  for (const std::string name : {"out.stl", "out.ply.txt", "out"}) {
+    const std::string out = dir_ + "/" + name;
+    std::ofstream(out) << "sentinel";
+    const CommandResult r =
+        RunCommand(kRefiner + " --workspace_path " + dir_ + " --output_path " + out + kFast);
+    ExpectRefused(r, "expected .ply or .obj", out, "sentinel");
+    EXPECT_NE(r.output.find(out), std::string::npos) << r.output;
+    EXPECT_EQ(r.output.find("Workspace "), std::string::npos) << "work was done:\n" << r.output;
+  }
+}
+
+// --output_path x.obj writes OBJ (with the vertex colours), not PLY bytes.
+TEST_F(MeshRefinerCli, ObjOutput) {
+  const std::string out = dir_ + "/refined.obj";
+  const CommandResult r =
+      RunCommand(kRefiner + " --workspace_path " + dir_ + " --output_path " + out + kFast);
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  EXPECT_EQ(ReadFileToString(out).rfind("ply", 0), std::string::npos);
+  const TriangleMesh mesh = ReadMesh(out);
+  EXPECT_GT(mesh.NumFaces(), 100);
+  EXPECT_EQ(mesh.C.rows(), mesh.NumVertices()) << "vertex colours expected";
+}
+
+// A held-out image name that the model does not have is an error naming it.
+TEST_F(MeshRefinerCli, HoldoutNameNotInTheModel) {
+  WriteSentinelOutput();
+  std::ofstream(dir_ + "/holdout.txt") << "view_1.png\nview_9.png\n";
+  const CommandResult r = RunCommand(kRefiner + " --workspace_path " + dir_ + " --holdout_path " +
+                                     dir_ + "/holdout.txt" + kFast);
+  ExpectRefused(r, "view_9.png", dir_ + "/meshed-refined.ply", "sentinel");
+  EXPECT_NE(r.output.find("not in the sparse model"), std::string::npos) << r.output;
+  EXPECT_NE(r.output.find(dir_ + "/holdout.txt"), std::string::npos) << r.output;
 }
 
 TEST_F(MeshRefinerCli, BadOptionNamesTheField) {

@@ -10,6 +10,7 @@
 #include <cstdio>
 #include <exception>
 #include <string>
+#include <vector>
 
 #include "colmap_io/mesh_io.h"
 #include "denoise/denoiser.h"
@@ -33,6 +34,7 @@ int Run(int argc, char** argv) {
                       "output mesh (.ply or .obj, written atomically)");
   options.Add("verbose", &verbose, "verbose logging");
   RegisterDenoiseOptions(&options, &denoise, "Denoise");
+  options.SetInputPaths([&] { return std::vector<std::string>{input_path}; });
   if (!options.Parse(argc, argv)) return 0;
   if (verbose) SetLogLevel(LogLevel::kVerbose);
   denoise.Check();
@@ -43,6 +45,7 @@ int Run(int argc, char** argv) {
       MR_THROW_INPUT << *path << ": unsupported extension '" << ext << "' (expected .ply or .obj)";
     }
   }
+  RefuseOutputOverInput("--output_path", output_path, {input_path});
   TriangleMesh mesh = ReadMesh(input_path);
   MR_LOG(INFO) << "Read " << input_path << ": " << mesh.NumVertices() << " vertices, "
                << mesh.NumFaces() << " faces";

@@ -7,6 +7,7 @@
 #include <exception>
 #include <iostream>
 #include <string>
+#include <vector>
 
 #include "colmap_io/mesh_io.h"
 #include "eval/evaluator.h"
@@ -40,6 +41,14 @@ int main(int argc, char** argv) {
                 "COLMAP workspace: measure only the ground truth seen by >= min_views of its "
                 "cameras (Middlebury-style observed surface)");
     manager.Add("min_views", &min_views, "with --workspace_path: views that must see a face (>= 1)");
+    manager.SetInputPaths([&] {
+      mr::WorkspaceOptions ws_options;
+      ws_options.use_masks = false;
+      std::vector<std::string> inputs = mr::WorkspaceInputPaths(workspace_path, ws_options);
+      inputs.push_back(input_path);
+      inputs.push_back(gt_path);
+      return inputs;
+    });
     if (!manager.Parse(argc, argv)) return 0;
     options.Check();
     for (const std::string& path : {input_path, gt_path}) {

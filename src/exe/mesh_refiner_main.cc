@@ -11,6 +11,7 @@
 #include <iostream>
 #include <set>
 
+#include "colmap_io/mesh_io.h"
 #include "colmap_io/ply.h"
 #include "colmap_io/workspace.h"
 #include "geometry/mesh.h"
@@ -70,9 +71,26 @@ int Run(int argc, char** argv) {
   options.Add("dry_run", &dry_run, "load and validate the workspace and mesh, print a summary, exit");
   options.Add("verbose", &verbose, "per-iteration details");
   RegisterRefineOptions(&options, &refine);
+  // Everything the run reads: no output may replace it or write into it.
+  const auto input_paths = [&] {
+    WorkspaceOptions ws_options;
+    ws_options.mask_path = mask_path;
+    ws_options.image_path = image_path;
+    std::vector<std::string> paths = WorkspaceInputPaths(workspace_path, ws_options);
+    paths.insert(paths.end(), {input_path, holdout_path});
+    return paths;
+  };
+  options.SetInputPaths(input_paths);
   if (!options.Parse(argc, argv)) return 0;
   if (verbose) SetLogLevel(LogLevel::kVerbose);
   refine.Check();
+  if (output_path.empty()) output_path = JoinPaths(workspace_path, "meshed-refined.ply");
+  RefuseOutputOverInput("--output_path", output_path, input_paths());
+  const std::string output_ext = GetExtension(output_path);
+  if (output_ext != ".ply" && output_ext != ".obj") {
+    MR_THROW_INPUT << "--output_path " << output_path << ": unsupported extension '" << output_ext
+                   << "' (expected .ply or .obj)";
+  }
 
   WorkspaceOptions ws_options;
   ws_options.mask_path = mask_path;
@@ -86,12 +104,7 @@ int Run(int argc, char** argv) {
                         "first or give --input_path";
     }
   }
-  if (output_path.empty()) output_path = JoinPaths(workspace_path, "meshed-refined.ply");
-  if (std::filesystem::exists(output_path) && std::filesystem::exists(input_path) &&
-      std::filesystem::equivalent(output_path, input_path)) {
-    MR_THROW_INPUT << "--output_path " << output_path
-                   << " is the input mesh; refusing to overwrite the input";
-  }
+  RefuseOutputOverInput("--output_path", output_path, {input_path});
   const std::string output_dir = GetParentDir(output_path);
   if (!output_dir.empty() && !ExistsDir(output_dir)) {
     MR_THROW_INPUT << "--output_path " << output_path << ": folder " << output_dir
@@ -103,6 +116,7 @@ int Run(int argc, char** argv) {
         const std::vector<std::string> names = ReadNameList(holdout_path);
         return std::set<std::string>(names.begin(), names.end());
       }();
+  CheckImageNamesInModel(workspace, {holdout.begin(), holdout.end()}, holdout_path);
   const WorkspaceViewSource source(workspace, holdout);
   TriangleMesh mesh = ReadPly(input_path);
   MR_LOG(INFO) << "Read " << input_path << ": " << mesh.NumVertices() << " vertices, "
@@ -130,7 +144,7 @@ int Run(int argc, char** argv) {
   }
 
   const RefineSummary summary = RefineMesh(source, refine, &mesh, &renderer);
-  WritePly(output_path, mesh);
+  WriteMesh(output_path, mesh);
   MR_LOG(INFO) << "Wrote " << output_path;
   std::cout << summary.FullReport();
   if (!holdout_views.empty()) {

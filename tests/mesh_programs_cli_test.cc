@@ -1,0 +1,116 @@
+// End-to-end tests of mesh_denoiser and mesh_evaluator as a user runs them:
+// no output may replace an input, however its path is spelled.
+
+#include <gtest/gtest.h>
+
+#include <filesystem>
+#include <fstream>
+
+#include "colmap_io/mesh_io.h"
+#include "colmap_io/ply.h"
+#include "tests/command.h"
+#include "util/file.h"
+
+namespace mr {
+namespace {
+
+namespace fs = std::filesystem;
+
+const std::string kDenoiser = std::string(MR_BIN_DIR) + "/mesh_denoiser";
+const std::string kEvaluator = std::string(MR_BIN_DIR) + "/mesh_evaluator";
+
+// An octahedron: small, closed, and quick for both programs.
+TriangleMesh Octahedron(double scale) {
+  TriangleMesh mesh;
+  mesh.V.resize(6, 3);
+  mesh.V << 1, 0, 0, -1, 0, 0, 0, 1, 0, 0, -1, 0, 0, 0, 1, 0, 0, -1;
+  mesh.V *= scale;
+  mesh.F.resize(8, 3);
+  mesh.F << 0, 2, 4, 2, 1, 4, 1, 3, 4, 3, 0, 4, 2, 0, 5, 1, 2, 5, 3, 1, 5, 0, 3, 5;
+  return mesh;
+}
+
+class MeshProgramsCli : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    dir_ = (fs::temp_directory_path() /
+            ("mr_cli_programs_" +
+             std::string(::testing::UnitTest::GetInstance()->current_test_info()->name())))
+               .string();
+    fs::remove_all(dir_);
+    fs::create_directories(dir_ + "/sub");
+    WritePly(dir_ + "/m.ply", Octahedron(1.0));
+    WritePly(dir_ + "/gt.ply", Octahedron(1.01));
+    mesh_bytes_ = ReadFileToString(dir_ + "/m.ply");
+    gt_bytes_ = ReadFileToString(dir_ + "/gt.ply");
+  }
+  void TearDown() override { fs::remove_all(dir_); }
+
+  // Refused: exit code 1, an ERROR line with `message`, the inputs
+  // byte-identical and no temporary file left.
+  void ExpectRefused(const std::string& command, const std::string& message) {
+    const CommandResult r = RunCommand(command);
+    EXPECT_EQ(r.exit_code, 1) << command << "\n" << r.output;
+    EXPECT_NE(r.output.find("ERROR: "), std::string::npos) << r.output;
+    EXPECT_NE(r.output.find(message), std::string::npos) << command << "\n" << r.output;
+    EXPECT_TRUE(ReadFileToString(dir_ + "/m.ply") == mesh_bytes_) << "m.ply was changed";
+    EXPECT_TRUE(ReadFileToString(dir_ + "/gt.ply") == gt_bytes_) << "gt.ply was changed";
+    for (const auto& name : ListFiles(dir_)) {
+      EXPECT_EQ(name.find(".tmp."), std::string::npos) << name;
+    }
+  }
+
+  std::string dir_, mesh_bytes_, gt_bytes_;
+};
+
+TEST_F(MeshProgramsCli, DenoiserOutputOverInputIsRefused) {
+  const std::string m = dir_ + "/m.ply";
+  ExpectRefused(kDenoiser + " --input_path " + m + " --output_path " + m, "refusing to overwrite");
+  ExpectRefused(kDenoiser + " --input_path " + m + " --output_path " + dir_ + "/sub/../m.ply",
+                "refusing to overwrite");
+  ExpectRefused("cd " + dir_ + "/sub && " + kDenoiser + " --input_path ../m.ply --output_path " +
+                    m,
+                "refusing to overwrite");
+  fs::create_symlink(m, dir_ + "/link.ply");
+  ExpectRefused(kDenoiser + " --input_path " + dir_ + "/link.ply --output_path " + m,
+                "refusing to overwrite");
+  fs::create_hard_link(m, dir_ + "/hard.ply");
+  ExpectRefused(kDenoiser + " --input_path " + dir_ + "/hard.ply --output_path " + m,
+                "refusing to overwrite");
+  // A different file is written.
+  const CommandResult r =
+      RunCommand(kDenoiser + " --input_path " + m + " --output_path " + dir_ + "/out.ply");
+  EXPECT_EQ(r.exit_code, 0) << r.output;
+  EXPECT_EQ(ReadMesh(dir_ + "/out.ply").NumFaces(), 8);
+}
+
+TEST_F(MeshProgramsCli, DenoiserWriteConfigOverInputIsRefused) {
+  const std::string m = dir_ + "/m.ply";
+  ExpectRefused(kDenoiser + " --input_path " + m + " --output_path " + dir_ + "/out.ply" +
+                    " --write_config " + m,
+                "refusing to overwrite");
+  const CommandResult r = RunCommand(kDenoiser + " --input_path " + m + " --output_path " + dir_ +
+                                     "/out.ply --write_config " + dir_ + "/d.ini");
+  EXPECT_EQ(r.exit_code, 0) << r.output;
+  EXPECT_TRUE(ExistsFile(dir_ + "/d.ini"));
+}
+
+TEST_F(MeshProgramsCli, DenoiserOutputExtension) {
+  std::ofstream(dir_ + "/out.stl") << "sentinel";
+  ExpectRefused(kDenoiser + " --input_path " + dir_ + "/m.ply --output_path " + dir_ + "/out.stl",
+                "expected .ply or .obj");
+  EXPECT_EQ(ReadFileToString(dir_ + "/out.stl"), "sentinel");
+}
+
+TEST_F(MeshProgramsCli, EvaluatorWriteConfigOverInputIsRefused) {
+  const std::string args = " --input_path " + dir_ + "/m.ply --gt_path " + dir_ + "/gt.ply";
+  ExpectRefused(kEvaluator + args + " --write_config " + dir_ + "/gt.ply", "refusing to overwrite");
+  ExpectRefused(kEvaluator + args + " --write_config " + dir_ + "/sub/../m.ply",
+                "refusing to overwrite");
+  const CommandResult r = RunCommand(kEvaluator + args);
+  EXPECT_EQ(r.exit_code, 0) << r.output;
+  EXPECT_NE(r.output.find("accuracy90"), std::string::npos) << r.output;
+}
+
+}  // namespace
+}  // namespace mr
