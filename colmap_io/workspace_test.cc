@@ -75,9 +75,10 @@ void WriteBytes(const std::string& path, const std::string& bytes) {
   std::ofstream(path, std::ios::binary | std::ios::trunc) << bytes;
 }
 
-std::string Encode(const std::string& ext, const cv::Mat& image) {
+std::string Encode(const std::string& ext, const cv::Mat& image,
+                   const std::vector<int>& params = {}) {
   std::vector<uchar> buffer;
-  EXPECT_TRUE(cv::imencode(ext, image, buffer));
+  EXPECT_TRUE(cv::imencode(ext, image, buffer, params));
   return std::string(buffer.begin(), buffer.end());
 }
 
@@ -385,8 +386,12 @@ TEST(Workspace, TruncatedImagesAreRefused) {
   cv::Mat noise(48, 64, CV_8UC3);
   cv::randu(noise, cv::Scalar::all(0), cv::Scalar::all(255));
   const std::string jpeg = Encode(".jpg", noise), png = Encode(".png", noise);
+  const std::string progressive = Encode(".jpg", noise, {cv::IMWRITE_JPEG_PROGRESSIVE, 1});
+  const std::string restarts = Encode(".jpg", noise, {cv::IMWRITE_JPEG_RST_INTERVAL, 2});
   for (const std::string& bytes :
-       {jpeg.substr(0, jpeg.size() / 2), png.substr(0, png.size() / 2)}) {
+       {jpeg.substr(0, jpeg.size() / 2), png.substr(0, png.size() / 2),
+        progressive.substr(0, progressive.size() * 3 / 4),
+        restarts.substr(0, restarts.size() - 10), jpeg.substr(0, jpeg.size() - 2) + "\0\0"}) {
     TempDir dir("ws_truncated");
     const std::string root = MakeWorkspace(dir, PinholeModel(), "sparse");
     WriteBytes(root + "/images/a.png", bytes);
@@ -430,7 +435,8 @@ TEST(Workspace, CompleteImagesWithTrailingBytesAreRead) {
   const std::string jpeg = Encode(".jpg", noise), png = Encode(".png", noise);
   for (const std::string& bytes :
        {jpeg + std::string(100, '\0'), jpeg + "appended data", png + std::string(16, '\0'),
-        JpegWithExifOrientation(noise, 1)}) {
+        JpegWithExifOrientation(noise, 1), Encode(".jpg", noise, {cv::IMWRITE_JPEG_PROGRESSIVE, 1}),
+        Encode(".jpg", noise, {cv::IMWRITE_JPEG_RST_INTERVAL, 2})}) {
     TempDir dir("ws_trailing");
     const std::string root = MakeWorkspace(dir, PinholeModel(), "sparse");
     WriteBytes(root + "/images/a.png", bytes);
