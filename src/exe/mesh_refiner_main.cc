@@ -117,7 +117,13 @@ int Run(int argc, char** argv) {
         return std::set<std::string>(names.begin(), names.end());
       }();
   CheckImageNamesInModel(workspace, {holdout.begin(), holdout.end()}, holdout_path);
-  const WorkspaceViewSource source(workspace, holdout);
+  WorkspaceViewSource source(workspace, holdout);
+  if (refine.color == "principal") {
+    const Eigen::Vector3d w = PrincipalTextureColor(source);
+    source.SetGrayWeights(w);
+    MR_LOG(INFO) << "Images compared along the colour direction of most texture (R, G, B) = ("
+                 << w(0) << ", " << w(1) << ", " << w(2) << ")";
+  }
   TriangleMesh mesh = ReadPly(input_path);
   MR_LOG(INFO) << "Read " << input_path << ": " << mesh.NumVertices() << " vertices, "
                << mesh.NumFaces() << " faces";

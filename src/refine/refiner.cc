@@ -16,7 +16,6 @@
 #include "geometry/remesh.h"
 #include "refine/pyramid.h"
 #include "refine/silhouette.h"
-#include "refine/step_filter.h"
 #include "render/renderer.h"
 #include "util/error.h"
 #include "util/logging.h"
@@ -319,6 +318,7 @@ bool RefineOptions::Check() const {
   if (!(max_step_px > 0)) fail("max_step_px", std::to_string(max_step_px), "max_step_px > 0");
   if (!(damping >= 0)) fail("damping", std::to_string(damping), "damping >= 0");
   if (similarity != "dcv" && similarity != "zncc") fail("similarity", similarity, "one of dcv, zncc");
+  if (color != "luminance" && color != "principal") fail("color", color, "one of luminance, principal");
   if (!(kappa >= 0)) fail("kappa", std::to_string(kappa), "kappa >= 0");
   if (regularizer != "lp" && regularizer != "laplacian" && regularizer != "none") {
     fail("regularizer", regularizer, "one of lp, laplacian, none");
@@ -346,6 +346,7 @@ std::string RefineSummary::FullReport() const {
   if (!schedule.empty()) out << "  schedule: " << schedule << "\n";
   out << "  views " << num_views << ", pairs " << num_pairs << ", vertices " << initial_vertices
       << " -> " << final_vertices << ", flipped faces fixed " << flipped_faces_fixed
+      << ", steps taken back " << steps_taken_back
       << ", intersecting pairs undone " << self_intersections_undone << " (" << vertices_reset
       << " vertex moves reset), self-intersections left " << self_intersections << "\n";
   out << "  surface moved: mean " << mean_displacement << ", max " << max_displacement
@@ -463,6 +464,8 @@ RefineSummary RefineMesh(const ViewSource& source, const RefineOptions& options,
     MR_LOG(INFO) << "Level " << level << ": " << views[0].width << "x" << views[0].height
                  << " images, " << F.rows() << " faces";
     const bool use_silhouettes = options.silhouette_weight > 0 && source.HasMasks();
+    double previous_similarity = 0;
+    Eigen::MatrixXd V_last_iterate;  // the mesh whose similarity is previous_similarity
     for (int it = 0; it < options.iterations_per_level; ++it, ++global_iteration) {
       const double t_iter = ElapsedSeconds();
       RefineIteration record;
@@ -491,48 +494,38 @@ RefineSummary RefineMesh(const ViewSource& source, const RefineOptions& options,
         MR_THROW_INPUT << "no pixel of any view pair sees a common surface point: the mesh is "
                           "not visible in overlapping views";
       }
+      // The level has converged when the last step raised the similarity by
+      // less than min_improvement; a step that lowered it is taken back.
+      if (it >= 1 && options.min_improvement > 0 &&
+          record.mean_similarity - previous_similarity < options.min_improvement) {
+        const bool worse = record.mean_similarity < previous_similarity;
+        if (worse) V = V_last_iterate;
+        MR_LOG(INFO) << "Level " << level << " converged after " << it << " iterations (similarity "
+                     << previous_similarity << " -> " << record.mean_similarity << ", below +"
+                     << options.min_improvement
+                     << (worse ? "; the last step lowered it and is taken back" : "") << ")";
+        if (worse) ++summary.steps_taken_back;
+        global_iteration += options.iterations_per_level - it;
+        break;
+      }
+      previous_similarity = record.mean_similarity;
+      if (options.min_improvement > 0) V_last_iterate = V;
 
-      // Gauss-Newton step down the reprojection error (filtered by the data
-      // confidence when filter_step is on), clamped to max_step_px footprints.
+      // Gauss-Newton step down the reprojection error, clamped to max_step_px
+      // footprints.
       const double mu = options.damping * MedianPositive(term.curvature);
-      Eigen::VectorXd confidence = Eigen::VectorXd::Zero(V.rows());
-      for (int v = 0; v < V.rows(); ++v) {
-        if (term.weight(v) > 0 && term.curvature(v) + mu > 0) confidence(v) = term.curvature(v) + mu;
-      }
       Eigen::MatrixXd step = Eigen::MatrixXd::Zero(V.rows(), 3);
-      if (options.filter_step) {
-        StepFilterSummary filtered;
-        step = FilterStep(options.step * term.gradient, confidence, F, options.step_filter,
-                          &filtered);
-        std::ostringstream report;
-        report << "step filter w=" << filtered.edge_weight << " jitter "
-               << filtered.jitter_before << "->" << filtered.jitter_after << " (cg "
-               << filtered.cg_iterations << ")";
-        record.step_filter_report = report.str();
-      } else {
-        for (int v = 0; v < V.rows(); ++v) {
-          if (confidence(v) > 0) step.row(v) = -options.step * term.gradient.row(v) / confidence(v);
+      for (int v = 0; v < V.rows(); ++v) {
+        if (term.weight(v) > 0 && term.curvature(v) + mu > 0) {
+          step.row(v) = -options.step * term.gradient.row(v) / (term.curvature(v) + mu);
         }
-      }
-      double mean_footprint = 0;
-      {
-        double sum = 0;
-        long count = 0;
-        for (int v = 0; v < V.rows(); ++v) {
-          if (term.weight(v) > 0) {
-            sum += term.footprint(v) / term.weight(v);
-            ++count;
-          }
-        }
-        mean_footprint = count > 0 ? sum / count : 0;
       }
       double step_sum = 0, step_max = 0;
       long num_moved = 0;
       for (int v = 0; v < V.rows(); ++v) {
         const double norm = step.row(v).norm();
         if (!(norm > 0)) continue;
-        const double footprint =
-            term.weight(v) > 0 ? term.footprint(v) / term.weight(v) : mean_footprint;
+        const double footprint = term.footprint(v) / term.weight(v);
         const double limit = options.max_step_px * footprint;
         if (norm > limit) step.row(v) *= limit / norm;
         step_sum += std::min(norm, limit) / footprint;
@@ -589,25 +582,11 @@ RefineSummary RefineMesh(const ViewSource& source, const RefineOptions& options,
       MR_LOG(INFO) << "Level " << level << " iteration " << it + 1 << "/"
                    << options.iterations_per_level << ": similarity " << record.mean_similarity
                    << ", step " << record.mean_step_px << " px (max " << record.max_step_px
-                   << "), " << record.step_filter_report << " " << record.regularizer_report << "; " << record.seconds
+                   << "), " << record.regularizer_report << "; " << record.seconds
                    << " s (data " << record.data_seconds << ", silhouette "
                    << record.silhouette_seconds << ", denoise " << record.denoise_seconds
                    << ", clean-up " << record.cleanup_seconds << ")";
       summary.iterations.push_back(record);
-      // The level has converged when the similarity measured before this
-      // step rose by less than min_improvement over the one before.
-      const size_t n_it = summary.iterations.size();
-      if (it >= 1 && options.min_improvement > 0 &&
-          summary.iterations[n_it - 1].mean_similarity -
-                  summary.iterations[n_it - 2].mean_similarity <
-              options.min_improvement) {
-        MR_LOG(INFO) << "Level " << level << " converged after " << it + 1
-                     << " iterations (similarity " << summary.iterations[n_it - 2].mean_similarity
-                     << " -> " << record.mean_similarity << ", below +" << options.min_improvement
-                     << ")";
-        global_iteration += options.iterations_per_level - it;
-        break;
-      }
     }
   }
 
@@ -658,12 +637,10 @@ void RegisterRefineOptions(OptionManager* o, RefineOptions* r) {
          "largest vertex motion per iteration, in pixel footprints (> 0)");
   o->Add("Refine.damping", &r->damping, "Levenberg damping relative to the median curvature");
   o->Add("Refine.similarity", &r->similarity, "dcv (detail-preserving) or zncc");
+  o->Add("Refine.color", &r->color,
+         "images compared on: luminance, or principal (colour direction of most texture)");
   o->Add("Refine.kappa", &r->kappa, "final weight of the detail-preserving term (>= 0)");
   o->Add("Refine.regularizer", &r->regularizer, "lp (content-aware L_p), laplacian or none");
-  o->Add("Refine.filter_step", &r->filter_step,
-         "smooth the gradient step by the data confidence (detail-preserving proximal step)");
-  o->Add("Refine.step_smoothing", &r->step_filter.smoothing,
-         "step filter edge weight relative to the median data confidence (> 0)");
   o->Add("Refine.noise_from_step", &r->noise_from_step,
          "lp proximal step: noise estimated from what the gradient step added, not the surface");
   o->Add("Refine.silhouette_weight", &r->silhouette_weight,

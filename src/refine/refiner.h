@@ -11,7 +11,6 @@
 #include "denoise/denoiser.h"
 #include "refine/photometric.h"
 #include "refine/similarity.h"
-#include "refine/step_filter.h"
 #include "refine/view_selection.h"
 #include "refine/view_source.h"
 
@@ -60,9 +59,9 @@ struct RefineOptions {
   int min_level_image_px = 100;
   // Largest number of gradient + denoising iterations at each level (>= 0).
   int iterations_per_level = 10;
-  // A level ends early when the mean ZNCC rose by less than this from one
-  // iteration to the next (ZNCC units, >= 0; 0 = always run
-  // iterations_per_level).
+  // A level ends early when the last step raised the mean ZNCC of all pairs
+  // by less than this (ZNCC units, >= 0; 0 = always run
+  // iterations_per_level); a last step that lowered it is taken back.
   double min_improvement = 0.0;
   // Target triangle edge length in pixels at every level (> 0). The mesh is
   // remeshed to it when a level starts.
@@ -76,6 +75,14 @@ struct RefineOptions {
   double max_step_px = 1.0;
   // Levenberg damping of the curvature, relative to its median (>= 0).
   double damping = 0.1;
+  // What the images are compared on: "luminance" (the grey image, as
+  // COLMAP reads it) or "principal" (the projection of the colour on the
+  // direction of most texture, PrincipalTextureColor in view_source.h; for
+  // grey images the same up to the grey weights). Applied by mesh_refiner to
+  // the workspace's images.
+  // "principal" is the default: on the corpus's colour-textured workspaces
+  // it lowers accuracy90 on 2 of 3 and the worst of them (docs/results.md).
+  std::string color = "principal";
   // Similarity: "dcv" (detail-preserving, the paper's) or "zncc".
   std::string similarity = "dcv";
   // Final κ of the detail-preserving term; κ grows linearly from
@@ -84,15 +91,13 @@ struct RefineOptions {
   // Regulariser of the proximal step: "lp" (content-aware L_p, the paper's),
   // "laplacian" (1st+2nd order), or "none".
   std::string regularizer = "lp";
-  // Smooth the gradient step by the data confidence before it is taken
-  // (refine/step_filter.h): removes the step's triangle-scale jitter without
-  // touching the surface's relief.
-  bool filter_step = false;
-  StepFilterOptions step_filter;
   // lp proximal step: estimate the noise to remove from what the gradient
   // step added (D applied to the step) instead of from the whole surface,
   // whose relief would count as noise (Denoise's noise_reference).
-  bool noise_from_step = false;
+  // Measured on the development corpus (docs/results.md): better accuracy90
+  // on 9 of 12 workspaces and the same worst case as the whole-surface
+  // estimate, which erases fine relief.
+  bool noise_from_step = true;
   // Weight of the silhouette (horizon) term when masks exist (>= 0; 0 = off).
   double silhouette_weight = 1.0;
   // Check every iteration for faces that the step made intersect and move
@@ -118,7 +123,6 @@ struct RefineIteration {
   double kappa = 0;
   double mean_step_px = 0;     // mean |gradient step| in pixel footprints
   double max_step_px = 0;
-  std::string step_filter_report;
   std::string regularizer_report;  // e.g. "p=0.5 theta=... sigma=... lambda=..."
   // Where the iteration's time went: renders and pair terms, the silhouette
   // term, the proximal (denoising) step, and the clean-up (flipped faces and
@@ -140,6 +144,7 @@ struct RefineSummary {
   double initial_similarity = 0;
   double final_similarity = 0;    // and after refinement
   int flipped_faces_fixed = 0;
+  int steps_taken_back = 0;  // min_improvement: last steps of a level that lowered the similarity
   long self_intersections_undone = 0;  // new intersecting pairs undone during the iterations
   int vertices_reset = 0;              // vertex moves undone for them
   int self_intersections = -1;    // of the result (-1: not computed)

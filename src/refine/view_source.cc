@@ -1,5 +1,6 @@
 #include "refine/view_source.h"
 
+#include <Eigen/Eigenvalues>
 #include <opencv2/imgproc.hpp>
 
 #include "refine/pyramid.h"
@@ -28,7 +29,28 @@ std::string WorkspaceViewSource::Name(int i) const {
   return workspace_.model.images.at(ids_.at(i)).name;
 }
 
+void WorkspaceViewSource::SetGrayWeights(const Eigen::Vector3d& rgb_weights) {
+  MR_CHECK(rgb_weights.allFinite() && rgb_weights.norm() > 0) << "bad colour weights";
+  gray_weights_ = rgb_weights;
+  project_color_ = true;
+}
+
 cv::Mat WorkspaceViewSource::LoadGray(int i) const {
+  if (project_color_) {
+    const cv::Mat bgr = workspace_.ReadImage(ids_.at(i), /*grayscale=*/false);
+    // Map the RGB cube onto [0, 1]: w . rgb ranges over [lo, hi].
+    double lo = 0, hi = 0;
+    for (int k = 0; k < 3; ++k) (gray_weights_(k) < 0 ? lo : hi) += gray_weights_(k);
+    const double scale = 1.0 / ((hi - lo) * (bgr.depth() == CV_16U ? 65535.0 : 255.0));
+    const cv::Matx13f m(static_cast<float>(gray_weights_(2) * scale),
+                        static_cast<float>(gray_weights_(1) * scale),
+                        static_cast<float>(gray_weights_(0) * scale));
+    cv::Mat f, out;
+    bgr.convertTo(f, CV_32F);
+    cv::transform(f, out, m);
+    out -= lo / (hi - lo);
+    return out;
+  }
   cv::Mat gray = workspace_.ReadImage(ids_.at(i), /*grayscale=*/true);
   cv::Mat out;
   gray.convertTo(out, CV_32F, gray.depth() == CV_16U ? 1.0 / 65535 : 1.0 / 255);
@@ -40,6 +62,37 @@ cv::Mat WorkspaceViewSource::LoadColor(int i) const {
 }
 
 cv::Mat WorkspaceViewSource::LoadMask(int i) const { return workspace_.ReadMask(ids_.at(i)); }
+
+Eigen::Vector3d PrincipalTextureColor(const ViewSource& source, int max_images,
+                                      double sigma_px) {
+  Eigen::Matrix3d covariance = Eigen::Matrix3d::Zero();
+  double count = 0;
+  const int n = source.NumViews();
+  const int used = std::min(n, std::max(1, max_images));
+  for (int k = 0; k < used; ++k) {
+    const int i = static_cast<int>(static_cast<long>(k) * n / used);
+    const cv::Mat bgr = source.LoadColor(i);
+    cv::Mat f, blurred;
+    bgr.convertTo(f, CV_32F, bgr.depth() == CV_16U ? 1.0 / 65535 : 1.0 / 255);
+    cv::GaussianBlur(f, blurred, cv::Size(), sigma_px);
+    const cv::Mat high = f - blurred;
+    const cv::Mat mask = source.LoadMask(i);
+    for (int r = 0; r < high.rows; ++r) {
+      for (int c = 0; c < high.cols; ++c) {
+        if (!mask.empty() && mask.at<uint8_t>(r, c) == 0) continue;
+        const cv::Vec3f v = high.at<cv::Vec3f>(r, c);
+        const Eigen::Vector3d rgb(v[2], v[1], v[0]);
+        covariance += rgb * rgb.transpose();
+        count += 1;
+      }
+    }
+  }
+  if (count == 0) return Eigen::Vector3d::Constant(1.0 / std::sqrt(3.0));
+  const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eigen(covariance / count);
+  Eigen::Vector3d w = eigen.eigenvectors().col(2);  // largest eigenvalue last
+  if (w.sum() < 0) w = -w;
+  return w.normalized();
+}
 
 void InMemoryViewSource::Add(const std::string& name, const PinholeView& view, const cv::Mat& gray,
                              const cv::Mat& mask) {

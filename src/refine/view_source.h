@@ -11,6 +11,7 @@
 #include <string>
 #include <vector>
 
+#include <Eigen/Core>
 #include <opencv2/core.hpp>
 
 #include "colmap_io/workspace.h"
@@ -50,11 +51,30 @@ class WorkspaceViewSource : public ViewSource {
   cv::Mat LoadMask(int i) const override;
   bool HasMasks() const override { return !workspace_.mask_dir.empty(); }
 
+  // The grey image LoadGray returns: by default the image as COLMAP reads it
+  // in grey (OpenCV's luminance). SetGrayWeights(w) makes it the projection
+  // of the colour on w instead (R, G, B weights; rescaled so that the RGB
+  // cube maps onto [0, 1]); one linear map for every image keeps brightness
+  // constancy. See PrincipalTextureColor.
+  void SetGrayWeights(const Eigen::Vector3d& rgb_weights);
+
  private:
   const Workspace& workspace_;
+  bool project_color_ = false;
+  Eigen::Vector3d gray_weights_ = Eigen::Vector3d::Zero();
   std::vector<uint32_t> ids_;
   std::vector<PinholeView> views_;
 };
+
+// The colour direction along which the images' texture varies most: the
+// principal eigenvector of the RGB covariance of the images' high-pass part
+// (colour minus its Gaussian blur of `sigma_px`, the scale a ZNCC window
+// sees), over the masks' foreground where there are masks, from up to
+// `max_images` evenly spaced views. Sign: non-negative sum. For grey images
+// (R = G = B) it is (1, 1, 1) / sqrt(3); for a texture that varies in hue
+// more than in brightness it follows the hue.
+Eigen::Vector3d PrincipalTextureColor(const ViewSource& source, int max_images = 16,
+                                      double sigma_px = 4.0);
 
 // Views and images held in memory (tests, synthetic scenes).
 class InMemoryViewSource : public ViewSource {
