@@ -18,6 +18,9 @@ namespace fs = std::filesystem;
 
 const std::string kDenoiser = std::string(MR_BIN_DIR) + "/mesh_denoiser";
 const std::string kEvaluator = std::string(MR_BIN_DIR) + "/mesh_evaluator";
+const std::string kInitializer = std::string(MR_BIN_DIR) + "/mesh_initializer";
+const std::string kMiddlebury = std::string(MR_BIN_DIR) + "/middlebury_to_colmap";
+const std::string kRender = std::string(MR_BIN_DIR) + "/mesh_render";
 
 // An octahedron: small, closed, and quick for both programs.
 TriangleMesh Octahedron(double scale) {
@@ -110,6 +113,34 @@ TEST_F(MeshProgramsCli, EvaluatorWriteConfigOverInputIsRefused) {
   const CommandResult r = RunCommand(kEvaluator + args);
   EXPECT_EQ(r.exit_code, 0) << r.output;
   EXPECT_NE(r.output.find("accuracy90"), std::string::npos) << r.output;
+}
+
+// The other programs name their inputs too: --write_config is refused over
+// a workspace's model or lists, into a Middlebury data set folder, and over
+// a second mesh. (Refused before the inputs are read, so stand-ins do.)
+TEST_F(MeshProgramsCli, OtherProgramsWriteConfigOverInputIsRefused) {
+  const std::string ws = dir_ + "/ws", cameras = ws + "/sparse/cameras.bin";
+  fs::create_directories(ws + "/sparse");
+  std::ofstream(cameras) << "model";
+  std::ofstream(ws + "/holdout.txt") << "a.png\n";
+  ExpectRefused(kInitializer + " --workspace_path " + ws + " --write_config " + cameras,
+                "refusing to overwrite");
+  ExpectRefused(kInitializer + " --workspace_path " + ws + " --write_config " + ws + "/holdout.txt",
+                "refusing to overwrite");
+  EXPECT_EQ(ReadFileToString(cameras), "model");
+  EXPECT_EQ(ReadFileToString(ws + "/holdout.txt"), "a.png\n");
+
+  const std::string mb = dir_ + "/temple";
+  fs::create_directories(mb);
+  std::ofstream(mb + "/temple_par.txt") << "0\n";
+  ExpectRefused(kMiddlebury + " --input_path " + mb + " --output_path " + dir_ + "/out" +
+                    " --write_config " + mb + "/temple_par.txt",
+                "refusing to overwrite");
+  EXPECT_EQ(ReadFileToString(mb + "/temple_par.txt"), "0\n");
+
+  ExpectRefused(kRender + " --input_path " + dir_ + "/m.ply --output_path " + dir_ +
+                    "/r.png --side_by_side " + dir_ + "/gt.ply --write_config " + dir_ + "/gt.ply",
+                "refusing to overwrite");
 }
 
 }  // namespace

@@ -5,6 +5,8 @@
 #include <exception>
 #include <iostream>
 #include <set>
+#include <string>
+#include <vector>
 
 #include "colmap_io/ply.h"
 #include "colmap_io/workspace.h"
@@ -53,6 +55,12 @@ int main(int argc, char** argv) {
                 "skip the images listed in <workspace>/holdout.txt");
     manager.Add("use_silhouette_list", &use_silhouette_list,
                 "use only the images listed in <workspace>/silhouette_images.txt, if present");
+    manager.SetInputPaths([&] {
+      std::vector<std::string> inputs = mr::WorkspaceInputPaths(workspace_path);
+      inputs.push_back(mr::JoinPaths(workspace_path, "holdout.txt"));
+      inputs.push_back(mr::JoinPaths(workspace_path, "silhouette_images.txt"));
+      return inputs;
+    });
     if (!manager.Parse(argc, argv)) return 0;
     options.Check();
     if (target_faces < 0) MR_THROW_INPUT << "--target_faces " << target_faces << ", expected >= 0";

@@ -6,6 +6,8 @@
 #include <iostream>
 #include <memory>
 #include <sstream>
+#include <string>
+#include <vector>
 
 #include <Eigen/Eigenvalues>
 #include <opencv2/core.hpp>
@@ -75,6 +77,13 @@ int main(int argc, char** argv) {
     manager.Add("lighting", &options.lighting, "key or headlight");
     manager.Add("ambient", &options.ambient, "ambient term in [0, 1)");
     manager.Add("background", &options.background, "background grey level 0..255");
+    manager.SetInputPaths([&] {
+      mr::WorkspaceOptions ws_options;
+      ws_options.use_masks = false;
+      std::vector<std::string> inputs = mr::WorkspaceInputPaths(workspace_path, ws_options);
+      inputs.insert(inputs.end(), {input_path, side_by_side});
+      return inputs;
+    });
     if (!manager.Parse(argc, argv)) return 0;
     options.Check();
     if (image_name.empty() == view_text.empty()) {

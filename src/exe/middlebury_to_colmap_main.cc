@@ -4,6 +4,8 @@
 
 #include <exception>
 #include <iostream>
+#include <string>
+#include <vector>
 
 #include "init/middlebury.h"
 #include "util/error.h"
@@ -34,6 +36,8 @@ int main(int argc, char** argv) {
                 "fill mask holes of at most this many pixels (0: none)");
     bool verbose = false;
     manager.Add("verbose", &verbose, "per-image details");
+    // The data set folder is input as a whole.
+    manager.SetInputPaths([&] { return std::vector<std::string>{input_path}; });
     if (!manager.Parse(argc, argv)) return 0;
     if (verbose) mr::SetLogLevel(mr::LogLevel::kVerbose);
     const mr::MiddleburyConversionSummary summary =
