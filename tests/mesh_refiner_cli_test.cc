@@ -141,6 +141,8 @@ TEST_F(MeshRefinerCli, MeshWithNoVisibleFacesFailsCleanly) {
   const CommandResult r = RunCommand(kRefiner + " --workspace_path " + dir_ + kFast);
   EXPECT_NE(r.exit_code, 0);
   EXPECT_NE(r.output.find("not visible"), std::string::npos) << r.output;
+  EXPECT_NE(r.output.find("meshed-poisson.ply: the mesh is not visible"), std::string::npos)
+      << r.output;
   EXPECT_TRUE(SentinelIntact());
 }
 

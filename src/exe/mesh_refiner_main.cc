@@ -118,12 +118,6 @@ int Run(int argc, char** argv) {
       }();
   CheckImageNamesInModel(workspace, {holdout.begin(), holdout.end()}, holdout_path);
   WorkspaceViewSource source(workspace, holdout);
-  if (refine.color == "principal") {
-    const Eigen::Vector3d w = PrincipalTextureColor(source);
-    source.SetGrayWeights(w);
-    MR_LOG(INFO) << "Images compared along the colour direction of most texture (R, G, B) = ("
-                 << w(0) << ", " << w(1) << ", " << w(2) << ")";
-  }
   TriangleMesh mesh = ReadPly(input_path);
   MR_LOG(INFO) << "Read " << input_path << ": " << mesh.NumVertices() << " vertices, "
                << mesh.NumFaces() << " faces";
@@ -133,6 +127,17 @@ int Run(int argc, char** argv) {
   if (dry_run) {
     PrintSummary(workspace, source, mesh, input_path);
     return 0;
+  }
+  if (!(MedianFootprint(source.Views(), mesh.V, VertexNormals(mesh.V, mesh.F)) > 0)) {
+    MR_THROW_INPUT << input_path
+                   << ": the mesh is not visible in any view: no vertex faces a camera inside its "
+                      "image (is the mesh in the same coordinate frame as the sparse model?)";
+  }
+  if (refine.color == "principal") {
+    const Eigen::Vector3d w = PrincipalTextureColor(source);
+    source.SetGrayWeights(w);
+    MR_LOG(INFO) << "Images compared along the colour direction of most texture (R, G, B) = ("
+                 << w(0) << ", " << w(1) << ", " << w(2) << ")";
   }
 
   Renderer renderer;
