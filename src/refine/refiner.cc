@@ -320,8 +320,9 @@ bool RefineOptions::Check() const {
   if (similarity != "dcv" && similarity != "zncc") fail("similarity", similarity, "one of dcv, zncc");
   if (color != "luminance" && color != "principal") fail("color", color, "one of luminance, principal");
   if (!(kappa >= 0)) fail("kappa", std::to_string(kappa), "kappa >= 0");
-  if (regularizer != "lp" && regularizer != "laplacian" && regularizer != "none") {
-    fail("regularizer", regularizer, "one of lp, laplacian, none");
+  if (regularizer != "lp" && regularizer != "laplacian" && regularizer != "bilateral_normal" &&
+      regularizer != "none") {
+    fail("regularizer", regularizer, "one of lp, laplacian, bilateral_normal, none");
   }
   if (!(silhouette_weight >= 0)) fail("silhouette_weight", std::to_string(silhouette_weight), "silhouette_weight >= 0");
   if (cache_mb < 64) fail("cache_mb", std::to_string(cache_mb), "cache_mb >= 64");
@@ -419,7 +420,7 @@ RefineSummary RefineMesh(const ViewSource& source, const RefineOptions& options,
   SimilarityOptions similarity = options.similarity_options;
   similarity.method = options.similarity;
   DenoiseOptions denoise = options.denoise;
-  denoise.method = options.regularizer == "laplacian" ? "laplacian" : "lp";
+  denoise.method = options.regularizer == "none" ? "lp" : options.regularizer;
 
   // The schedule: how many pyramid levels, from the input's similarity at
   // each level (ChooseNumLevels), unless num_levels is given.

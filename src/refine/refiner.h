@@ -31,6 +31,13 @@ class Renderer;
 // For the Laplacian baseline (--Refine.regularizer laplacian) the proximal
 // step is one first+second order smoothing pass per iteration, the explicit
 // form of the proximal operator of a quadratic smoothness energy.
+// For the default, bilateral_normal (the two-stage scheme: filter the face
+// normals, then fit the vertices to them), 3 normal-filtering passes and 15
+// vertex-update passes per iteration, range sigma 0.35 on |n_i - n_j|,
+// spatial sigma the mesh's own mean distance between neighbouring face
+// centroids: chosen on the 12-workspace development corpus
+// (docs/results.md: 2/10 passes and the L_p step were worse on its worst
+// case).
 inline DenoiseOptions ProximalDenoiseOptions() {
   DenoiseOptions options;
   options.max_iterations = 1;
@@ -40,6 +47,8 @@ inline DenoiseOptions ProximalDenoiseOptions() {
   options.inner_iterations = 1;
   options.lambda_scale = 10.0;
   options.laplacian_iterations = 1;
+  options.normal_iterations = 3;
+  options.vertex_iterations = 15;
   return options;
 }
 
@@ -88,9 +97,13 @@ struct RefineOptions {
   // Final κ of the detail-preserving term; κ grows linearly from
   // kappa / (total iterations) to kappa over the run (>= 0).
   double kappa = 0.5;
-  // Regulariser of the proximal step: "lp" (content-aware L_p, the paper's),
-  // "laplacian" (1st+2nd order), or "none".
-  std::string regularizer = "lp";
+  // Regulariser of the proximal step: "bilateral_normal" (the default:
+  // bilateral filtering of the face normals, then the vertices fitted to
+  // them; piecewise smooth, so curved relief and creases stay), "lp" (the
+  // paper's content-aware L_p prior on D X: piecewise flat, it rounds fine
+  // relief off), "laplacian" (1st+2nd order, the isotropic baseline), or
+  // "none".
+  std::string regularizer = "bilateral_normal";
   // lp proximal step: estimate the noise to remove from what the gradient
   // step added (D applied to the step) instead of from the whole surface,
   // whose relief would count as noise (Denoise's noise_reference).
