@@ -12,6 +12,7 @@
 #include "colmap_io/workspace.h"
 #include "eval/evaluator.h"
 #include "tests/command.h"
+#include "tests/observed_evaluation.h"
 #include "util/file.h"
 
 namespace mr {
@@ -76,20 +77,11 @@ TEST_F(ColmapWorkspace, RefinementImprovesObservedAccuracy) {
   const CommandResult r =
       RunCommand(std::string(MR_BIN_DIR) + "/mesh_refiner --workspace_path " + dense);
   ASSERT_EQ(r.exit_code, 0) << r.output;
-  const TriangleMesh gt = ReadPly(dir_ + "/ground_truth.ply");
-  const TriangleMesh before = ReadPly(dense + "/meshed-poisson.ply");
-  const TriangleMesh after = ReadPly(dense + "/meshed-refined.ply");
-  const Workspace workspace = OpenWorkspace(dense);
-  std::vector<PinholeView> views;
-  for (uint32_t id : workspace.image_ids) {
-    const Image& image = workspace.model.images.at(id);
-    views.push_back(ViewFromColmap(workspace.model.cameras.at(image.camera_id), image));
-  }
-  const std::vector<char> observed = ObservedFaces(gt.V, gt.F, views, 2);
   EvaluationOptions options;
   options.num_samples = 50000;
-  const EvaluationResult b = EvaluateMesh(before.V, before.F, gt.V, gt.F, options, &observed);
-  const EvaluationResult a = EvaluateMesh(after.V, after.F, gt.V, gt.F, options, &observed);
+  const ObservedEvaluation e = EvaluateObservedSurface(dense, dir_ + "/ground_truth.ply", options);
+  const EvaluationResult& b = e.input;
+  const EvaluationResult& a = e.refined;
   EXPECT_LT(a.accuracy90, 0.8 * b.accuracy90) << b.ToJson() << "\n" << a.ToJson() << "\n" << r.output;
   EXPECT_LT(a.chamfer, b.chamfer) << b.ToJson() << "\n" << a.ToJson();
   EXPECT_GE(a.completeness, b.completeness - 1.0) << b.ToJson() << "\n" << a.ToJson();

@@ -16,6 +16,7 @@
 #include "colmap_io/workspace.h"
 #include "eval/evaluator.h"
 #include "tests/command.h"
+#include "tests/observed_evaluation.h"
 #include "util/file.h"
 
 namespace mr {
@@ -75,19 +76,10 @@ TEST_P(CorpusGuard, DefaultsImproveTheObservedSurface) {
   const CommandResult r =
       RunCommand(std::string(MR_BIN_DIR) + "/mesh_refiner --workspace_path " + dense);
   ASSERT_EQ(r.exit_code, 0) << r.output;
-  const TriangleMesh gt = ReadPly(dir + "/ground_truth.ply");
-  const TriangleMesh before = ReadPly(dense + "/meshed-poisson.ply");
-  const TriangleMesh after = ReadPly(dense + "/meshed-refined.ply");
-  const Workspace workspace = OpenWorkspace(dense);
-  std::vector<PinholeView> views;
-  for (uint32_t id : workspace.image_ids) {
-    const Image& image = workspace.model.images.at(id);
-    views.push_back(ViewFromColmap(workspace.model.cameras.at(image.camera_id), image));
-  }
-  const std::vector<char> observed = ObservedFaces(gt.V, gt.F, views, 2);
-  EvaluationOptions options;
-  const EvaluationResult b = EvaluateMesh(before.V, before.F, gt.V, gt.F, options, &observed);
-  const EvaluationResult a = EvaluateMesh(after.V, after.F, gt.V, gt.F, options, &observed);
+  const ObservedEvaluation e =
+      EvaluateObservedSurface(dense, dir + "/ground_truth.ply", EvaluationOptions());
+  const EvaluationResult& b = e.input;
+  const EvaluationResult& a = e.refined;
   EXPECT_LT(a.accuracy90, c.max_accuracy_ratio * b.accuracy90)
       << b.ToJson() << "\n" << a.ToJson() << "\n" << r.output;
   EXPECT_LT(a.normal_deg, c.max_normal_ratio * b.normal_deg) << b.ToJson() << "\n" << a.ToJson();

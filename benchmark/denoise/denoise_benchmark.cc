@@ -135,9 +135,16 @@ int Quality(const std::string& models_dir, const std::string& only, const std::s
     Eigen::MatrixXi F;
   };
   std::vector<Model> models;
-  for (const char* name : {"fandisk", "rocker-arm", "stanford-bunny"}) {
+  for (const char* name : {"fandisk", "rocker-arm", "stanford-bunny", "beast", "igea"}) {
     Model m{name, {}, {}};
-    ReadObj(models_dir + "/" + name + ".obj", &m.V, &m.F);
+    const std::string obj = models_dir + "/" + name + ".obj";
+    if (std::ifstream(obj).good()) {
+      ReadObj(obj, &m.V, &m.F);
+    } else {
+      const mr::TriangleMesh mesh = mr::ReadMesh(models_dir + "/" + name + ".ply");
+      m.V = mesh.V;
+      m.F = mesh.F;
+    }
     models.push_back(m);
   }
   {
