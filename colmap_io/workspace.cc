@@ -147,6 +147,7 @@ Workspace OpenWorkspaceImpl(const std::string& path, const WorkspaceOptions& opt
 
   std::string mask_dir;
   if (!options.use_masks) {
+    // Cameras only (mesh_evaluator, mesh_render): no mask folder is looked for.
   } else if (!options.mask_path.empty()) {
     if (!ExistsDir(options.mask_path)) {
       MR_THROW_INPUT << options.mask_path << ": mask folder does not exist";

@@ -99,15 +99,21 @@ void RemeshForLevel(const std::vector<PinholeView>& views, const RefineOptions& 
                << edge / footprint << " px at this level, " << ElapsedSeconds() - t0 << " s)";
 }
 
+// Upper median of `values` (which must not be empty); reorders them.
+template <typename T>
+T Median(std::vector<T>& values) {
+  MR_CHECK(!values.empty());
+  std::nth_element(values.begin(), values.begin() + values.size() / 2, values.end());
+  return values[values.size() / 2];
+}
+
 // Median of the positive entries, or 0.
 double MedianPositive(const Eigen::VectorXd& x) {
   std::vector<double> values;
   for (int i = 0; i < x.size(); ++i) {
     if (x(i) > 0) values.push_back(x(i));
   }
-  if (values.empty()) return 0;
-  std::nth_element(values.begin(), values.begin() + values.size() / 2, values.end());
-  return values[values.size() / 2];
+  return values.empty() ? 0.0 : Median(values);
 }
 
 // Sums the data term over all ordered pairs of the level.
@@ -186,7 +192,6 @@ void SampleVertexColors(const ViewSource& source, const Eigen::MatrixXd& V,
 struct Schedule {
   int num_levels = 1;
   double misalignment_px = 0;  // median image misalignment of the input
-  double initial_similarity = 0;
   std::string reason;
 };
 
@@ -219,35 +224,29 @@ double MeasureMisalignmentPx(const std::vector<PinholeView>& views,
     predicted32.convertTo(b8, CV_8U, 255.0);
     cv::Mat flow;
     cv::calcOpticalFlowFarneback(a8, b8, flow, 0.5, 5, 15, 3, 5, 1.1, 0);
-    cv::Mat gx, gy;
+    cv::Mat gx, gy, gradient;
     cv::Sobel(image_i, gx, CV_32F, 1, 0);
     cv::Sobel(image_i, gy, CV_32F, 0, 1);
+    cv::magnitude(gx, gy, gradient);
     std::vector<float> gradients;
     for (int r = 0; r < erode.rows; ++r) {
       for (int c = 0; c < erode.cols; ++c) {
-        if (erode.at<uint8_t>(r, c)) gradients.push_back(std::hypot(gx.at<float>(r, c), gy.at<float>(r, c)));
+        if (erode.at<uint8_t>(r, c)) gradients.push_back(gradient.at<float>(r, c));
       }
     }
-    std::nth_element(gradients.begin(), gradients.begin() + gradients.size() / 2, gradients.end());
-    const float gradient_median = gradients[gradients.size() / 2];
+    const float gradient_median = Median(gradients);
     std::vector<float> shifts;
     for (int r = 0; r < erode.rows; ++r) {
       for (int c = 0; c < erode.cols; ++c) {
-        if (!erode.at<uint8_t>(r, c) ||
-            std::hypot(gx.at<float>(r, c), gy.at<float>(r, c)) <= gradient_median) {
-          continue;
-        }
+        if (!erode.at<uint8_t>(r, c) || gradient.at<float>(r, c) <= gradient_median) continue;
         const cv::Vec2f f = flow.at<cv::Vec2f>(r, c);
         shifts.push_back(std::hypot(f[0], f[1]));
       }
     }
     if (shifts.empty()) continue;
-    std::nth_element(shifts.begin(), shifts.begin() + shifts.size() / 2, shifts.end());
-    per_pair.push_back(shifts[shifts.size() / 2]);
+    per_pair.push_back(Median(shifts));
   }
-  if (per_pair.empty()) return 0;
-  std::nth_element(per_pair.begin(), per_pair.begin() + per_pair.size() / 2, per_pair.end());
-  return per_pair[per_pair.size() / 2];
+  return per_pair.empty() ? 0.0 : Median(per_pair);
 }
 
 // Picks the number of pyramid levels from the input itself: its misalignment
@@ -621,7 +620,7 @@ RefineSummary RefineMesh(const ViewSource& source, const RefineOptions& options,
 
 void RegisterRefineOptions(OptionManager* o, RefineOptions* r) {
   o->Add("Refine.num_levels", &r->num_levels,
-         "image pyramid levels, coarse to fine (1..6; 0: chosen from the input's similarity)");
+         "image pyramid levels, coarse to fine (1..6; 0: chosen from the input's misalignment)");
   o->Add("Refine.schedule_misalignment_px", &r->schedule_misalignment_px,
          "num_levels 0: coarse levels until the input's misalignment is below this (pixels)");
   o->Add("Refine.min_level_image_px", &r->min_level_image_px,
@@ -641,7 +640,9 @@ void RegisterRefineOptions(OptionManager* o, RefineOptions* r) {
   o->Add("Refine.color", &r->color,
          "images compared on: luminance, or principal (colour direction of most texture)");
   o->Add("Refine.kappa", &r->kappa, "final weight of the detail-preserving term (>= 0)");
-  o->Add("Refine.regularizer", &r->regularizer, "lp (content-aware L_p), laplacian or none");
+  o->Add("Refine.regularizer", &r->regularizer,
+         "bilateral_normal (normals filtered, vertices fitted), lp (content-aware L_p), laplacian "
+         "or none");
   o->Add("Refine.noise_from_step", &r->noise_from_step,
          "lp proximal step: noise estimated from what the gradient step added, not the surface");
   o->Add("Refine.silhouette_weight", &r->silhouette_weight,
