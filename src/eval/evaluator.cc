@@ -50,8 +50,18 @@ class Random {
   uint64_t state_;
 };
 
+// The vertex indices of face f in increasing order: what is computed from a
+// face in this order does not depend on its winding (or on which vertex is
+// listed first), down to the last bit.
+Eigen::Vector3i SortedFace(const Eigen::MatrixXi& F, Eigen::Index f) {
+  Eigen::Vector3i face = F.row(f).transpose();
+  std::sort(face.data(), face.data() + 3);
+  return face;
+}
+
 // Area-uniform samples on the mesh (faces chosen with probability
-// proportional to their area, uniform barycentric position inside).
+// proportional to their area, uniform barycentric position inside). The
+// samples do not depend on the faces' winding.
 std::vector<Sample> SampleMesh(const Eigen::MatrixXd& V, const Eigen::MatrixXi& F,
                                const Eigen::VectorXd& areas, int num_samples, uint64_t seed) {
   std::vector<double> cumulative(F.rows());
@@ -70,7 +80,8 @@ std::vector<Sample> SampleMesh(const Eigen::MatrixXd& V, const Eigen::MatrixXi& 
     while (areas(f) <= 0 && f > 0) --f;  // never a zero-area face
     const double r1 = std::sqrt(random.Uniform());
     const double r2 = random.Uniform();
-    const Eigen::Vector3d a = V.row(F(f, 0)), b = V.row(F(f, 1)), c = V.row(F(f, 2));
+    const Eigen::Vector3i face = SortedFace(F, f);
+    const Eigen::Vector3d a = V.row(face(0)), b = V.row(face(1)), c = V.row(face(2));
     samples[i].point = (1 - r1) * a + r1 * (1 - r2) * b + r1 * r2 * c;
     samples[i].face = f;
   }
@@ -99,7 +110,9 @@ struct Distances {
 };
 
 // Distance from every sample to the target mesh, and the angle between the
-// sample's face normal and the normal of the closest target triangle.
+// sample's face normal and the normal of the closest target triangle as
+// unoriented lines, min(theta, 180 - theta) in [0, 90] degrees: neither
+// mesh's face winding (inward or outward, or mixed) changes it.
 Distances Query(const std::vector<Sample>& samples, const Eigen::MatrixXd& sample_normals,
                 const Eigen::MatrixXd& V, const Eigen::MatrixXi& F) {
   const Eigen::MatrixXd target_normals = FaceNormals(V, F);
@@ -119,7 +132,7 @@ Distances Query(const std::vector<Sample>& samples, const Eigen::MatrixXd& sampl
     const Eigen::Vector3d a = sample_normals.row(samples[i].face);
     const Eigen::Vector3d b = target_normals.row(target_face);
     if (a.squaredNorm() > 0.5 && b.squaredNorm() > 0.5) {
-      const double cosine = std::max(-1.0, std::min(1.0, a.dot(b)));
+      const double cosine = std::min(1.0, std::abs(a.dot(b)));
       result.angle_deg[i] = std::acos(cosine) * 180.0 / M_PI;
     } else {
       result.angle_deg[i] = std::nan("");
@@ -146,7 +159,11 @@ ClosestPointQuery::ClosestPointQuery(const Eigen::MatrixXd& V, const Eigen::Matr
   MR_CHECK(F.rows() > 0) << "ClosestPointQuery on an empty mesh";
   impl_->triangles.reserve(F.rows());
   for (Eigen::Index f = 0; f < F.rows(); ++f) {
-    const auto p = [&](int k) { return Point(V(F(f, k), 0), V(F(f, k), 1), V(F(f, k), 2)); };
+    // Vertices in index order: the computed distances, and so the closest
+    // face where two are equally close (over a shared edge), do not depend on
+    // the winding.
+    const Eigen::Vector3i face = SortedFace(F, f);
+    const auto p = [&](int k) { return Point(V(face(k), 0), V(face(k), 1), V(face(k), 2)); };
     impl_->triangles.emplace_back(p(0), p(1), p(2));
   }
   impl_->tree.insert(impl_->triangles.cbegin(), impl_->triangles.cend());
@@ -289,21 +306,22 @@ EvaluationResult EvaluateMesh(const Eigen::MatrixXd& V, const Eigen::MatrixXi& F
 std::vector<char> ObservedFaces(const Eigen::MatrixXd& V, const Eigen::MatrixXi& F,
                                 const std::vector<PinholeView>& views, int min_views) {
   MR_CHECK_GE(min_views, 1);
-  // A face is seen by a view if its centroid faces the camera, projects into
-  // the image, and is not hidden: its depth matches the rendered depth at that
-  // pixel within two pixel footprints. Testing the centroid (not pixel
-  // coverage) counts faces smaller than a pixel too.
-  const Eigen::MatrixXd N = FaceNormals(V, F);
+  // A face is seen by a view if its centroid projects into the image in
+  // front of the camera and is not hidden: its depth matches the rendered
+  // depth at that pixel within two pixel footprints. Testing the centroid (not
+  // pixel coverage) counts faces smaller than a pixel too. No back-face test:
+  // the renderer draws both sides, so the depth test alone decides, and the
+  // result does not depend on the faces' winding (a ground truth wound inward
+  // is observed like one wound outward).
   std::vector<int> count(F.rows(), 0);
   Renderer renderer;
   renderer.SetMesh(V, F);
   for (const PinholeView& view : views) {
     const RenderBuffers render = renderer.Render(view);
-    const Eigen::Vector3d center = view.Center();
 #pragma omp parallel for schedule(static)
     for (int f = 0; f < static_cast<int>(F.rows()); ++f) {
-      const Eigen::Vector3d x = (V.row(F(f, 0)) + V.row(F(f, 1)) + V.row(F(f, 2))) / 3.0;
-      if (N.row(f).dot(center - x) <= 0) continue;
+      const Eigen::Vector3i face = SortedFace(F, f);
+      const Eigen::Vector3d x = (V.row(face(0)) + V.row(face(1)) + V.row(face(2))) / 3.0;
       const Eigen::Vector3d xc = view.WorldToCamera(x);
       if (xc.z() <= 0) continue;
       const Eigen::Vector2d p = view.CameraToImage(xc);

@@ -27,7 +27,9 @@ struct EvaluationResult {
   double accuracy90 = 0;     // 90th percentile of recon->GT distances
   double completeness = 0;   // % of GT samples within `threshold` of recon
   double chamfer = 0;        // mean(recon->GT) + mean(GT->recon), i.e. sum of both means
-  double normal_deg = 0;     // mean angle between recon and closest-GT face normals (oriented)
+  // Mean angle between recon and closest-GT face normals as unoriented lines,
+  // min(theta, 180 - theta): independent of either mesh's face winding.
+  double normal_deg = 0;
   double mean_accuracy = 0;  // mean recon->GT distance
   int faces = 0;             // faces of the evaluated mesh
   // With an observed-face mask: % of the ground truth's area observed (the
@@ -71,8 +73,9 @@ SurfaceDisplacement MeasureSurfaceDisplacement(const Eigen::MatrixXd& V,
                                                const Eigen::MatrixXi& F0);
 
 // Faces of (V, F) visible in at least `min_views` of `views`: the face's
-// centroid faces the camera, lies in the image and is not occluded (depth
-// test against an EGL render). Works for faces smaller than a pixel.
+// centroid lies in the image and is not occluded (depth test against an EGL
+// render, which draws both sides of every face). Works for faces smaller than
+// a pixel; independent of the faces' winding (no back-face culling).
 std::vector<char> ObservedFaces(const Eigen::MatrixXd& V, const Eigen::MatrixXi& F,
                                 const std::vector<PinholeView>& views, int min_views);
 

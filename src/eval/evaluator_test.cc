@@ -197,15 +197,35 @@ TEST(EvaluateMesh, TranslatedPlane) {
   EXPECT_EQ(EvaluateMesh(plane.V, plane.F, moved, plane.F, options).completeness, 0.0);
 }
 
-TEST(EvaluateMesh, FlippedNormalsGive180Degrees) {
+// Normals are compared as unoriented lines: a ground truth wound the other
+// way is the same surface (the oriented angle would be 180 degrees).
+TEST(EvaluateMesh, FlippedNormalsGiveZeroDegrees) {
   const Mesh plane = Plane(4);
   Eigen::MatrixXi flipped = plane.F;
   flipped.col(1).swap(flipped.col(2));
   EvaluationOptions options;
   options.num_samples = 2000;
   const EvaluationResult result = EvaluateMesh(plane.V, plane.F, plane.V, flipped, options);
-  EXPECT_NEAR(result.normal_deg, 180.0, 1e-3);
+  EXPECT_LT(result.normal_deg, 1e-3);
   EXPECT_LT(result.accuracy90, 1e-12);
+}
+
+// The angle is min(theta, 180 - theta): a plane tilted by 30 degrees about
+// the x axis gives 30 degrees whichever way either is wound.
+TEST(EvaluateMesh, NormalAngleIsUnsigned) {
+  const Mesh plane = Plane(4);
+  Eigen::MatrixXd tilted = plane.V;
+  const double a = 30.0 * M_PI / 180.0;
+  tilted.col(2) = plane.V.col(1) * std::sin(a);
+  tilted.col(1) = plane.V.col(1) * std::cos(a);
+  Eigen::MatrixXi flipped = plane.F;
+  flipped.col(1).swap(flipped.col(2));
+  EvaluationOptions options;
+  options.num_samples = 2000;
+  for (const Eigen::MatrixXi* gt_F : std::vector<const Eigen::MatrixXi*>{&plane.F, &flipped}) {
+    EXPECT_NEAR(EvaluateMesh(plane.V, plane.F, tilted, *gt_F, options).normal_deg, 30.0, 1e-6);
+    EXPECT_NEAR(EvaluateMesh(plane.V, flipped, tilted, *gt_F, options).normal_deg, 30.0, 1e-6);
+  }
 }
 
 // Half of the GT is missing from the reconstruction: completeness ~50%,
@@ -358,6 +378,71 @@ TEST(ObservedFaces, UnseenBumpIsExcluded) {
   EXPECT_LT(masked.observed_percent, 95);
   EXPECT_NE(masked.ToJson().find("observed_percent"), std::string::npos);
   EXPECT_EQ(all.ToJson().find("observed_percent"), std::string::npos);
+}
+
+// A closed ground truth wound outward and the same wound inward are the same
+// surface: every figure, and the observed part, must be the same. The
+// reconstruction is a coarser, bumpy, slightly larger sphere, so that
+// distances, normal errors and completeness are all far from trivial.
+double SignedVolume(const Eigen::MatrixXd& V, const Eigen::MatrixXi& F) {
+  double volume = 0;
+  for (int f = 0; f < F.rows(); ++f) {
+    const Eigen::Vector3d a = V.row(F(f, 0)), b = V.row(F(f, 1)), c = V.row(F(f, 2));
+    volume += a.dot(b.cross(c)) / 6.0;
+  }
+  return volume;
+}
+
+TEST(EvaluateMesh, GroundTruthWindingDoesNotMatter) {
+  Eigen::MatrixXd gt_V;
+  Eigen::MatrixXi outward;
+  MakeIcosphere(4, 1.0, &gt_V, &outward);
+  ASSERT_GT(SignedVolume(gt_V, outward), 0);
+  Eigen::MatrixXi inward = outward;
+  inward.col(1).swap(inward.col(2));
+  ASSERT_LT(SignedVolume(gt_V, inward), 0);
+  Eigen::MatrixXd V;
+  Eigen::MatrixXi F;
+  MakeIcosphere(3, 1.0, &V, &F);
+  for (int v = 0; v < V.rows(); ++v) {
+    V.row(v) *= 1.01 + 0.02 * std::sin(7 * V(v, 0)) * std::cos(5 * V(v, 2));
+  }
+  std::vector<PinholeView> views;  // a ring above the equator: the bottom is unseen
+  for (int i = 0; i < 8; ++i) {
+    const double a = 2 * M_PI * i / 8;
+    views.push_back(LookAtView(Eigen::Vector3d(4 * std::cos(a), 4 * std::sin(a), 2.5),
+                               Eigen::Vector3d::Zero(), Eigen::Vector3d(0, 0, 1), 80, 60, 80));
+  }
+  const std::vector<char> seen_outward = ObservedFaces(gt_V, outward, views, 2);
+  const std::vector<char> seen_inward = ObservedFaces(gt_V, inward, views, 2);
+  EXPECT_TRUE(seen_outward == seen_inward);
+  EvaluationOptions options;
+  options.num_samples = 20000;
+  options.threshold = 0.02;
+  for (const bool masked : {false, true}) {
+    const EvaluationResult a = EvaluateMesh(V, F, gt_V, outward, options,
+                                            masked ? &seen_outward : nullptr);
+    const EvaluationResult b = EvaluateMesh(V, F, gt_V, inward, options,
+                                            masked ? &seen_inward : nullptr);
+    SCOPED_TRACE(masked ? "observed surface" : "whole surface");
+    EXPECT_NEAR(a.accuracy90, b.accuracy90, 1e-9);
+    EXPECT_NEAR(a.mean_accuracy, b.mean_accuracy, 1e-9);
+    EXPECT_NEAR(a.chamfer, b.chamfer, 1e-9);
+    EXPECT_NEAR(a.completeness, b.completeness, 1e-9);
+    EXPECT_NEAR(a.normal_deg, b.normal_deg, 1e-9);
+    EXPECT_NEAR(a.observed_percent, b.observed_percent, 1e-9);
+    // Not a trivial comparison: the figures are far from 0 and 100, and the
+    // mask keeps part of the surface only.
+    EXPECT_GT(a.accuracy90, 0.01);
+    EXPECT_GT(a.normal_deg, 1.0);
+    EXPECT_LT(a.normal_deg, 45.0);  // the oriented angle would be about 180 for one of them
+    EXPECT_GT(a.completeness, 5.0);
+    EXPECT_LT(a.completeness, 95.0);
+    if (masked) {
+      EXPECT_GT(a.observed_percent, 30.0);
+      EXPECT_LT(a.observed_percent, 95.0);
+    }
+  }
 }
 
 }  // namespace
