@@ -36,6 +36,17 @@ void AccumulateSilhouetteTerm(const Eigen::MatrixXd& V, const Eigen::MatrixXi& F
                               Eigen::VectorXd* count) {
   MR_CHECK(signed_distance.type() == CV_32F && signed_distance.cols == view.width &&
            signed_distance.rows == view.height);
+  MR_CHECK(render.width == view.width && render.height == view.height);
+  // The rendered silhouette's own signed distance: a contour vertex of a
+  // triangle mesh can project up to an edge inside the outline that its
+  // neighbours draw, so the error is the difference of the two fields at the
+  // vertex, not the observed field alone (which pushed such vertices outward
+  // even where outline and mask agree: the surface inflated).
+  cv::Mat rendered(view.height, view.width, CV_8U);
+  for (int r = 0; r < view.height; ++r) {
+    for (int c = 0; c < view.width; ++c) rendered.at<uint8_t>(r, c) = render.FaceAt(r, c) >= 0;
+  }
+  const cv::Mat rendered_distance = SignedDistanceToMask(rendered);
   const Eigen::Vector3d center = view.Center();
   // A vertex is on the contour generator if it has both front- and
   // back-facing incident faces.
@@ -71,8 +82,10 @@ void AccumulateSilhouetteTerm(const Eigen::MatrixXd& V, const Eigen::MatrixXi& F
     Eigen::Vector3d u = n - n.dot(ray) * ray;
     if (u.norm() < 1e-6) continue;
     u.normalize();
-    const double s = std::clamp(
-        SampleBilinear(signed_distance, p.x(), p.y(), nullptr), -max_px, max_px);
+    const double s =
+        std::clamp(SampleBilinear(signed_distance, p.x(), p.y(), nullptr) -
+                       SampleBilinear(rendered_distance, p.x(), p.y(), nullptr),
+                   -max_px, max_px);
     const double footprint = xc.z() / view.fx;
     displacement->row(v) += (s * footprint) * u.transpose();
     (*count)(v) += 1;

@@ -4,9 +4,11 @@
 // M_horiz (eq. evolution_eq_horiz) moves contour generators so that the
 // rendered silhouette matches the observed one against a black background.
 // We use its geometric form: a vertex on the occluding contour of view i
-// that projects at signed distance s (pixels, positive inside the mask) from
-// the mask boundary is pulled by s pixel footprints along the image-plane
-// component of its normal (outward when s > 0, inward when s < 0).
+// is pulled along the image-plane component of its normal by s pixel
+// footprints, s = (signed distance to the mask boundary) - (signed distance
+// to the rendered outline) at its projection (pixels, positive inside):
+// outward where the mask reaches beyond the rendered outline, inward where
+// it stops short, and not at all where the two agree.
 
 #include <opencv2/core.hpp>
 
