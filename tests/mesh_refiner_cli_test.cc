@@ -4,6 +4,10 @@
 
 #include <gtest/gtest.h>
 
+#include <poll.h>
+#include <sys/stat.h>
+
+#include <chrono>
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
@@ -280,6 +284,80 @@ TEST_F(MeshRefinerCli, HoldoutNameNotInTheModel) {
   ExpectRefused(r, "view_9.png", dir_ + "/meshed-refined.ply", "sentinel");
   EXPECT_NE(r.output.find("not in the sparse model"), std::string::npos) << r.output;
   EXPECT_NE(r.output.find(dir_ + "/holdout.txt"), std::string::npos) << r.output;
+}
+
+// SIGINT in the middle of the iterations (a run of 1000 iterations): the
+// program stops at once with status 130 and one line saying so; the existing
+// output is untouched and nothing temporary is left.
+TEST_F(MeshRefinerCli, SigintStopsPromptlyAndLeavesNothing) {
+  WriteSentinelOutput();
+  const std::string log = dir_ + "/../mr_cli_sigint.log";
+  fs::remove(log);
+  const pid_t pid = SpawnCommand({kRefiner, "--workspace_path", dir_, "--Refine.num_levels", "1",
+                                  "--Refine.iterations_per_level", "1000",
+                                  "--Refine.target_edge_px", "4"},
+                                 log);
+  ASSERT_GT(pid, 0);
+  const bool started = WaitForLogText(pid, log, "iteration 1/1000", 300);
+  if (!started) ::kill(pid, SIGKILL);
+  ASSERT_TRUE(started) << ReadFileToString(log);
+  const auto t0 = std::chrono::steady_clock::now();
+  ASSERT_EQ(::kill(pid, SIGINT), 0);
+  const int status = WaitForExit(pid);
+  const double seconds =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  const std::string output = ReadFileToString(log);
+  fs::remove(log);
+  EXPECT_EQ(status, 130) << output;
+  EXPECT_LT(seconds, 5.0);
+  EXPECT_NE(output.find("ERROR: interrupted by SIGINT"), std::string::npos) << output;
+  EXPECT_TRUE(SentinelIntact());
+  for (const auto& name : ListFiles(dir_)) EXPECT_EQ(name.find(".tmp."), std::string::npos) << name;
+}
+
+// SIGTERM while the output is being written: its temporary
+// (meshed-refined.ply.tmp.<pid>) is made a FIFO before the program gets
+// there, so the writer blocks half-way through the mesh (the pipe holds 4
+// KB) and is interrupted there. Status 143, the temporary removed, the
+// existing output untouched.
+TEST_F(MeshRefinerCli, SigtermDuringTheWriteRemovesTheTemporary) {
+  WriteSentinelOutput();
+  const std::string log = dir_ + "/../mr_cli_sigterm.log";
+  fs::remove(log);
+  const pid_t pid = SpawnCommand({kRefiner, "--workspace_path", dir_, "--Refine.num_levels", "1",
+                                  "--Refine.iterations_per_level", "1",
+                                  "--Refine.target_edge_px", "4"},
+                                 log);
+  ASSERT_GT(pid, 0);
+  // The program reads, refines and renders for seconds before it writes.
+  const std::string tmp = dir_ + "/meshed-refined.ply.tmp." + std::to_string(pid);
+  ASSERT_EQ(::mkfifo(tmp.c_str(), 0644), 0);
+  const int reader = ::open(tmp.c_str(), O_RDONLY | O_NONBLOCK);
+  ASSERT_GE(reader, 0);
+  ::fcntl(reader, F_SETPIPE_SZ, 4096);
+  // Readable: the writer has opened the temporary and written into it.
+  struct pollfd poll_fd = {reader, POLLIN, 0};
+  bool writing = false;
+  for (int waited_ms = 0; waited_ms < 300000 && !writing; waited_ms += 100) {
+    writing = ::poll(&poll_fd, 1, 100) > 0 && (poll_fd.revents & POLLIN);
+    int status = 0;
+    if (!writing && ::waitpid(pid, &status, WNOHANG) == pid) break;
+  }
+  if (!writing) ::kill(pid, SIGKILL);
+  ASSERT_TRUE(writing) << ReadFileToString(log);
+  std::this_thread::sleep_for(std::chrono::milliseconds(200));  // the pipe fills
+  ASSERT_TRUE(fs::exists(tmp));
+  ASSERT_EQ(::kill(pid, SIGTERM), 0);
+  const int status = WaitForExit(pid);
+  ::close(reader);
+  const std::string output = ReadFileToString(log);
+  fs::remove(log);
+  EXPECT_EQ(status, 143) << output;
+  EXPECT_NE(output.find("ERROR: interrupted by SIGTERM"), std::string::npos) << output;
+  EXPECT_FALSE(fs::exists(tmp)) << "the temporary was left behind";
+  fs::remove(tmp);
+  EXPECT_TRUE(SentinelIntact());
+  for (const auto& name : ListFiles(dir_)) EXPECT_EQ(name.find(".tmp."), std::string::npos) << name;
 }
 
 TEST_F(MeshRefinerCli, BadOptionNamesTheField) {

@@ -1,6 +1,10 @@
 #include "util/file.h"
 
+#include <fcntl.h>
 #include <unistd.h>
+
+#include <cerrno>
+#include <cstring>
 
 #include <algorithm>
 #include <cctype>
@@ -9,6 +13,7 @@
 #include <sstream>
 
 #include "util/error.h"
+#include "util/interrupt.h"
 
 namespace mr {
 namespace fs = std::filesystem;
@@ -129,6 +134,7 @@ void WriteFileAtomically(const std::string& path,
     MR_THROW_INPUT << path << ": output folder " << dir.string() << " does not exist";
   }
   const std::string tmp = path + ".tmp." + std::to_string(::getpid());
+  const TemporaryFileRegistration removed_on_interrupt(tmp);
   try {
     {
       std::ofstream out(tmp, std::ios::binary | std::ios::trunc);
@@ -144,6 +150,72 @@ void WriteFileAtomically(const std::string& path,
     std::error_code ignored;
     fs::remove(tmp, ignored);
     throw;
+  }
+}
+
+namespace {
+
+// Creates and removes an empty file "<name>.tmp.<pid>.probe" in `dir`;
+// returns "" or why it could not (the system's words).
+std::string ProbeCreateFile(const fs::path& dir, const std::string& name) {
+  const std::string probe =
+      (dir / (name + ".tmp." + std::to_string(::getpid()) + ".probe")).string();
+  const TemporaryFileRegistration removed_on_interrupt(probe);
+  const int fd = ::open(probe.c_str(), O_WRONLY | O_CREAT | O_EXCL | O_CLOEXEC, 0644);
+  if (fd < 0) return std::strerror(errno);
+  ::close(fd);
+  if (::unlink(probe.c_str()) != 0) return std::strerror(errno);
+  return "";
+}
+
+}  // namespace
+
+void CheckOutputFile(const std::string& what, const std::string& path) {
+  if (path.empty()) MR_THROW_INPUT << what << ": empty path";
+  std::error_code ec;
+  if (fs::is_directory(path, ec)) {
+    MR_THROW_INPUT << what << " " << path << ": is a folder; expected a file name";
+  }
+  const fs::path target(path);
+  if (target.filename().empty() || target.filename() == "." || target.filename() == "..") {
+    MR_THROW_INPUT << what << " " << path << ": expected a file name, not a folder";
+  }
+  const fs::path dir = target.parent_path().empty() ? fs::path(".") : target.parent_path();
+  if (!fs::exists(dir, ec)) {
+    MR_THROW_INPUT << what << " " << path << ": folder " << dir.string() << " does not exist";
+  }
+  if (!fs::is_directory(dir, ec)) {
+    MR_THROW_INPUT << what << " " << path << ": " << dir.string() << " is not a folder";
+  }
+  const std::string why = ProbeCreateFile(dir, target.filename().string());
+  if (!why.empty()) {
+    MR_THROW_INPUT << what << " " << path << ": cannot create a file in folder " << dir.string()
+                   << " (" << why << "); choose a writable folder";
+  }
+}
+
+void CheckOutputFolder(const std::string& what, const std::string& path) {
+  if (path.empty()) MR_THROW_INPUT << what << ": empty path";
+  std::error_code ec;
+  fs::path dir = fs::absolute(path, ec).lexically_normal();
+  if (dir.filename().empty() && dir.has_parent_path()) dir = dir.parent_path();
+  if (fs::exists(dir, ec) && !fs::is_directory(dir, ec)) {
+    MR_THROW_INPUT << what << " " << path << ": is a file; expected a folder";
+  }
+  // The folder itself, or the nearest existing folder it will be created in.
+  fs::path existing = dir;
+  while (!fs::exists(existing, ec) && existing.has_parent_path() &&
+         existing.parent_path() != existing) {
+    existing = existing.parent_path();
+  }
+  if (!fs::is_directory(existing, ec)) {
+    MR_THROW_INPUT << what << " " << path << ": " << existing.string()
+                   << " is not a folder; cannot create " << path;
+  }
+  const std::string why = ProbeCreateFile(existing, ".mesh_refiner");
+  if (!why.empty()) {
+    MR_THROW_INPUT << what << " " << path << ": cannot create files in folder "
+                   << existing.string() << " (" << why << "); choose a writable folder";
   }
 }
 

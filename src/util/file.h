@@ -37,10 +37,23 @@ std::vector<std::string> ReadNameList(const std::string& path);
 void RefuseOutputOverInput(const std::string& what, const std::string& output,
                            const std::vector<std::string>& inputs);
 
+// Refuses, before any work, an output file that could not be written:
+// throws InputError "<what> <path>: <why>" if `path` is a folder, its folder
+// does not exist or is not a folder, or no file can be created in that
+// folder (no permission, a read-only or virtual file system such as /proc or
+// /sys): checked by creating and removing "<path>.tmp.<pid>.probe". An
+// existing `path` is not touched.
+void CheckOutputFile(const std::string& what, const std::string& path);
+// The same for an output folder that the program creates or fills: an
+// existing `path` must be a folder that accepts new files; a missing one is
+// probed in its nearest existing ancestor, which must be a folder.
+void CheckOutputFolder(const std::string& what, const std::string& path);
+
 // Writes a file atomically: `write` fills a temporary file in the same folder
 // (opened in binary mode as `path + ".tmp.<pid>"`), which is renamed onto
 // `path` only if `write` returns without throwing and the stream is good. On
-// any failure the temporary is removed and an existing `path` is untouched.
+// any failure the temporary is removed and an existing `path` is untouched;
+// an interrupt (SIGINT, SIGTERM) removes it too (util/interrupt.h).
 void WriteFileAtomically(const std::string& path,
                          const std::function<void(std::ostream&)>& write);
 

@@ -246,6 +246,7 @@ bool OptionManager::Parse(int argc, char** argv) {
       for (const std::string& path : input_paths_()) inputs.push_back(path);
     }
     RefuseOutputOverInput("--write_config", write_config, inputs);
+    CheckOutputFile("--write_config", write_config);
     WriteConfig(write_config);
     return false;
   }

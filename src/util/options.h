@@ -13,7 +13,8 @@
 // `--write_config FILE` writes the effective options and exits; it refuses
 // (InputError) a FILE that resolves to an input: --config_path, the value of
 // any "*_path" option that is not an output ("output_*") or a folder, and
-// whatever SetInputPaths returns. Booleans take
+// whatever SetInputPaths returns, and one that cannot be written
+// (CheckOutputFile). Booleans take
 // 1/0/true/false, or no value (meaning true). `-h`/`--help` prints usage.
 
 #include <functional>

@@ -8,6 +8,7 @@
 #include <exception>
 
 #include "util/error.h"
+#include "util/interrupt.h"
 
 namespace mr {
 namespace {
@@ -32,6 +33,7 @@ void KeepFreedBuffersInProcess() {
 
 int RunProgram(const std::function<int()>& body) {
   KeepFreedBuffersInProcess();
+  InstallInterruptHandlers();
   try {
     return body();
   } catch (const InputError& e) {

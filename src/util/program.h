@@ -8,8 +8,10 @@
 //
 // mr::InputError (bad input: files, flags, workspaces) prints one line
 // "ERROR: <what>"; any other exception "ERROR (internal): <what>". Both
-// return exit status 1. It also sets glibc to reuse freed multi-MB buffers
-// instead of returning them to the kernel at once (see program.cc).
+// return exit status 1. SIGINT and SIGTERM remove the temporary files of
+// unfinished outputs and exit with status 130 / 143 (util/interrupt.h). It
+// also sets glibc to reuse freed multi-MB buffers instead of returning them
+// to the kernel at once (see program.cc).
 
 #include <functional>
 

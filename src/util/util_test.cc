@@ -1,11 +1,16 @@
 #include <gtest/gtest.h>
 
+#include <signal.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
 
 #include "util/error.h"
 #include "util/file.h"
+#include "util/interrupt.h"
 #include "util/testing.h"
 #include "util/options.h"
 
@@ -69,6 +74,93 @@ TEST(RefuseOutputOverInput, SameFileHoweverSpelled) {
   RefuseOutputOverInput("--output_path", dir + "/sub2/x.ply", {dir + "/sub"});
   RefuseOutputOverInput("--output_path", dir + "/m.ply.bak", {m});
   RefuseOutputOverInput("--output_path", "", {m});
+}
+
+// No file in `dir` whose name has ".tmp." (a temporary or a probe).
+void ExpectNoTemporary(const std::string& dir) {
+  for (const auto& name : ListFiles(dir)) EXPECT_EQ(name.find(".tmp."), std::string::npos) << name;
+}
+
+TEST(CheckOutputFile, WritableFolderPasses) {
+  const std::string dir = MakeTestDir("check_output");
+  CheckOutputFile("--output_path", JoinPaths(dir, "new.ply"));
+  const std::string existing = JoinPaths(dir, "old.ply");
+  WriteFileAtomically(existing, [](std::ostream& out) { out << "old"; });
+  CheckOutputFile("--output_path", existing);
+  EXPECT_EQ(ReadFileToString(existing), "old");
+  EXPECT_FALSE(ExistsFile(JoinPaths(dir, "new.ply")));
+  ExpectNoTemporary(dir);
+  const std::filesystem::path cwd = std::filesystem::current_path();
+  std::filesystem::current_path(dir);
+  CheckOutputFile("--output_path", "relative.ply");  // the current folder
+  std::filesystem::current_path(cwd);
+  ExpectNoTemporary(dir);
+}
+
+TEST(CheckOutputFile, UnwritableOutputsAreRefused) {
+  const std::string dir = MakeTestDir("check_output_bad");
+  CreateDirIfNotExists(JoinPaths(dir, "folder.ply"));
+  WriteFileAtomically(JoinPaths(dir, "file"), [](std::ostream& out) { out << "x"; });
+  ExpectInputError([&] { CheckOutputFile("--output_path", JoinPaths(dir, "folder.ply")); },
+                   {"--output_path " + dir + "/folder.ply", "is a folder"});
+  ExpectInputError([&] { CheckOutputFile("--output_path", dir + "/"); }, {"folder"});
+  ExpectInputError([&] { CheckOutputFile("--output_path", JoinPaths(dir, "nope/a.ply")); },
+                   {"folder " + dir + "/nope does not exist"});
+  ExpectInputError([&] { CheckOutputFile("--output_path", JoinPaths(dir, "file/a.ply")); },
+                   {dir + "/file is not a folder"});
+  // Virtual file systems: the folder exists, no file can be made in it (root
+  // included, so this holds whoever runs the test).
+  ExpectInputError([&] { CheckOutputFile("--write_config", "/proc/a.ini"); },
+                   {"--write_config /proc/a.ini", "cannot create a file in folder /proc"});
+  ExpectInputError([&] { CheckOutputFile("--output_path", "/sys/a.ply"); },
+                   {"cannot create a file in folder /sys"});
+  ExpectInputError([&] { CheckOutputFile("--output_path", ""); }, {"empty path"});
+  ExpectNoTemporary(dir);
+}
+
+TEST(CheckOutputFolder, ExistingMissingAndUnwritable) {
+  const std::string dir = MakeTestDir("check_output_folder");
+  CheckOutputFolder("--output_path", dir);
+  CheckOutputFolder("--output_path", JoinPaths(dir, "new/deeper"));  // made later
+  EXPECT_FALSE(ExistsDir(JoinPaths(dir, "new")));
+  WriteFileAtomically(JoinPaths(dir, "file"), [](std::ostream& out) { out << "x"; });
+  ExpectInputError([&] { CheckOutputFolder("--output_path", JoinPaths(dir, "file")); },
+                   {"is a file; expected a folder"});
+  ExpectInputError([&] { CheckOutputFolder("--output_path", JoinPaths(dir, "file/sub")); },
+                   {"is not a folder"});
+  ExpectInputError([&] { CheckOutputFolder("--output_path", "/proc/new_folder"); },
+                   {"cannot create files in folder /proc"});
+  ExpectNoTemporary(dir);
+}
+
+// In a child process (the handler ends the process): a registered temporary
+// is removed by SIGINT / SIGTERM, whose exit status is 128 + signal; one
+// whose registration has ended is left alone.
+TEST(InterruptHandlers, RemoveRegisteredTemporariesAndExit) {
+  const std::string dir = MakeTestDir("interrupt");
+  for (const int signal_number : {SIGINT, SIGTERM}) {
+    const std::string tmp = JoinPaths(dir, "out.ply.tmp.1"), kept = JoinPaths(dir, "kept.tmp.2");
+    const pid_t pid = ::fork();
+    ASSERT_GE(pid, 0);
+    if (pid == 0) {
+      ::signal(SIGINT, SIG_DFL);
+      ::signal(SIGTERM, SIG_DFL);
+      InstallInterruptHandlers();
+      { TemporaryFileRegistration done(kept); }
+      std::ofstream(kept) << "no longer registered";
+      const TemporaryFileRegistration registration(tmp);
+      std::ofstream(tmp) << "half-written";
+      ::raise(signal_number);
+      ::_exit(99);  // not reached
+    }
+    int status = 0;
+    ASSERT_EQ(::waitpid(pid, &status, 0), pid);
+    ASSERT_TRUE(WIFEXITED(status)) << "killed by signal " << WTERMSIG(status);
+    EXPECT_EQ(WEXITSTATUS(status), 128 + signal_number);
+    EXPECT_FALSE(ExistsFile(tmp));
+    EXPECT_TRUE(ExistsFile(kept));
+    std::filesystem::remove(kept);
+  }
 }
 
 TEST(ReadNameList, SkipsBlankLinesAndComments) {
