@@ -13,15 +13,21 @@ struct ModelInfo {
   const char* name;
   int num_params;
   bool separate_focal;  // fx, fy (else a single f)
+  const char* params;   // COLMAP's parameter names, comma-separated
 };
 
 const ModelInfo kModels[] = {
-    {"SIMPLE_PINHOLE", 3, false}, {"PINHOLE", 4, true},
-    {"SIMPLE_RADIAL", 4, false},  {"RADIAL", 5, false},
-    {"OPENCV", 8, true},          {"OPENCV_FISHEYE", 8, true},
-    {"FULL_OPENCV", 12, true},    {"FOV", 5, true},
-    {"SIMPLE_RADIAL_FISHEYE", 4, false}, {"RADIAL_FISHEYE", 5, false},
-    {"THIN_PRISM_FISHEYE", 12, true},
+    {"SIMPLE_PINHOLE", 3, false, "f,cx,cy"},
+    {"PINHOLE", 4, true, "fx,fy,cx,cy"},
+    {"SIMPLE_RADIAL", 4, false, "f,cx,cy,k"},
+    {"RADIAL", 5, false, "f,cx,cy,k1,k2"},
+    {"OPENCV", 8, true, "fx,fy,cx,cy,k1,k2,p1,p2"},
+    {"OPENCV_FISHEYE", 8, true, "fx,fy,cx,cy,k1,k2,k3,k4"},
+    {"FULL_OPENCV", 12, true, "fx,fy,cx,cy,k1,k2,p1,p2,k3,k4,k5,k6"},
+    {"FOV", 5, true, "fx,fy,cx,cy,omega"},
+    {"SIMPLE_RADIAL_FISHEYE", 4, false, "f,cx,cy,k"},
+    {"RADIAL_FISHEYE", 5, false, "f,cx,cy,k1,k2"},
+    {"THIN_PRISM_FISHEYE", 12, true, "fx,fy,cx,cy,k1,k2,p1,p2,k3,k4,sx1,sy1"},
 };
 
 const ModelInfo& Info(CameraModel model) {
@@ -139,6 +145,25 @@ CameraModel CameraModelFromName(const std::string& name) {
 }
 
 int CameraModelNumParams(CameraModel model) { return Info(model).num_params; }
+
+std::vector<std::string> CameraModelParamNames(CameraModel model) {
+  std::vector<std::string> names;
+  std::string name;
+  for (const char* c = Info(model).params;; ++c) {
+    if (*c == ',' || *c == '\0') {
+      names.push_back(name);
+      name.clear();
+      if (*c == '\0') break;
+    } else {
+      name += *c;
+    }
+  }
+  return names;
+}
+
+int CameraModelNumDistortionParams(CameraModel model) {
+  return Info(model).num_params - ExtraOffset(model);
+}
 
 bool IsPinholeModel(CameraModel model) {
   return model == CameraModel::kSimplePinhole || model == CameraModel::kPinhole;

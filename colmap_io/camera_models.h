@@ -31,6 +31,10 @@ std::string CameraModelName(CameraModel model);
 // Inverse of CameraModelName; throws InputError naming the text.
 CameraModel CameraModelFromName(const std::string& name);
 int CameraModelNumParams(CameraModel model);
+// COLMAP's names of the parameters, in order ("fx", "fy", "cx", "cy", "k1", ...).
+std::vector<std::string> CameraModelParamNames(CameraModel model);
+// Parameters after the focal length(s) and principal point: the distortion.
+int CameraModelNumDistortionParams(CameraModel model);
 // True for SIMPLE_PINHOLE and PINHOLE (no distortion).
 bool IsPinholeModel(CameraModel model);
 

@@ -28,6 +28,19 @@ TEST(CameraModels, NamesRoundTrip) {
   EXPECT_FALSE(IsPinholeModel(CameraModel::kSimpleRadial));
 }
 
+TEST(CameraModels, ParamNames) {
+  for (int id = 0; id <= 10; ++id) {
+    const CameraModel model = static_cast<CameraModel>(id);
+    EXPECT_EQ(static_cast<int>(CameraModelParamNames(model).size()), CameraModelNumParams(model));
+  }
+  EXPECT_EQ(CameraModelParamNames(CameraModel::kOpenCV),
+            (std::vector<std::string>{"fx", "fy", "cx", "cy", "k1", "k2", "p1", "p2"}));
+  EXPECT_EQ(CameraModelParamNames(CameraModel::kRadial)[3], "k1");
+  EXPECT_EQ(CameraModelNumDistortionParams(CameraModel::kRadial), 2);
+  EXPECT_EQ(CameraModelNumDistortionParams(CameraModel::kPinhole), 0);
+  EXPECT_EQ(CameraModelNumDistortionParams(CameraModel::kThinPrismFisheye), 8);
+}
+
 TEST(CameraModels, FocalAndPrincipalPoint) {
   const std::vector<double> p = {500, 510, 321.5, 239.25};
   EXPECT_EQ(CameraFocalX(CameraModel::kPinhole, p), 500);

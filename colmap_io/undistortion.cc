@@ -1,5 +1,6 @@
 #include "colmap_io/undistortion.h"
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
@@ -40,7 +41,79 @@ Camera UndistortedCamera(const Camera& camera) {
   return out;
 }
 
+namespace {
+
+// Share of the undistorted image's pixels (every `stride`-th row and column)
+// whose sample lies outside the distorted image, or is not finite: the part
+// that would come out black.
+double OutsideFraction(const Camera& camera, int stride) {
+  const Camera pinhole = UndistortedCamera(camera);
+  const double fx = pinhole.params[0], fy = pinhole.params[1], cx = pinhole.params[2],
+               cy = pinhole.params[3];
+  long outside = 0, total = 0;
+  for (int row = 0; row < static_cast<int>(camera.height); row += stride) {
+    for (int col = 0; col < static_cast<int>(camera.width); col += stride) {
+      const Eigen::Vector2d n((col + 0.5 - cx) / fx, (row + 0.5 - cy) / fy);
+      const Eigen::Vector2d d = CameraImageFromWorld(camera.model, camera.params, n);
+      const bool inside = d.allFinite() && d.x() >= 0 && d.x() <= camera.width && d.y() >= 0 &&
+                          d.y() <= camera.height;
+      outside += inside ? 0 : 1;
+      ++total;
+    }
+  }
+  return total > 0 ? static_cast<double>(outside) / total : 0.0;
+}
+
+// "k1 = 5, k2 = 0" for the distortion parameters of `camera`.
+std::string DistortionText(const Camera& camera) {
+  const std::vector<std::string> names = CameraModelParamNames(camera.model);
+  const int first = CameraModelNumParams(camera.model) - CameraModelNumDistortionParams(camera.model);
+  std::ostringstream text;
+  for (int i = first; i < CameraModelNumParams(camera.model); ++i) {
+    text << (i > first ? ", " : "") << names[i] << " = " << camera.params[i];
+  }
+  return text.str();
+}
+
+// Refuses a camera whose distortion sends more than kMaxOutsideFraction of
+// the undistorted image outside the distorted one (OPENCV k1 = 5, RADIAL
+// k1 = 240: the refinement then compares black images and "finishes" at
+// similarity 0). Names the parameter(s) that alone bring it back within
+// bounds when set to 0.
+constexpr double kMaxOutsideFraction = 0.5;
+
+void CheckDistortionRange(const Camera& camera) {
+  const long pixels = static_cast<long>(camera.width) * camera.height;
+  const int stride = std::max(1, static_cast<int>(std::sqrt(pixels / 40000.0)));
+  const double outside = OutsideFraction(camera, stride);
+  if (outside <= kMaxOutsideFraction) return;
+  std::ostringstream culprits;
+  const std::vector<std::string> names = CameraModelParamNames(camera.model);
+  const int first = CameraModelNumParams(camera.model) - CameraModelNumDistortionParams(camera.model);
+  for (int i = first; i < CameraModelNumParams(camera.model); ++i) {
+    if (camera.params[i] == 0) continue;
+    Camera without = camera;
+    without.params[i] = 0;
+    const double fraction = OutsideFraction(without, stride);
+    if (fraction <= kMaxOutsideFraction) {
+      culprits << (culprits.tellp() > 0 ? "; " : "") << names[i] << " = " << camera.params[i]
+               << " (with " << names[i] << " = 0: " << std::lround(100 * fraction) << " %)";
+    }
+  }
+  MR_THROW_INPUT << "camera " << camera.camera_id << " (" << CameraModelName(camera.model) << ", "
+                 << DistortionText(camera) << "): " << std::lround(100 * outside)
+                 << " % of the undistorted " << camera.width << "x" << camera.height
+                 << " image would sample outside the distorted image (at most "
+                 << std::lround(100 * kMaxOutsideFraction) << " % allowed): "
+                 << (culprits.tellp() > 0 ? "implausible distortion parameter " + culprits.str()
+                                          : std::string("implausible distortion parameters"))
+                 << "; check the sparse model's cameras";
+}
+
+}  // namespace
+
 void ComputeUndistortionMaps(const Camera& camera, cv::Mat* map_x, cv::Mat* map_y) {
+  CheckDistortionRange(camera);
   const Camera pinhole = UndistortedCamera(camera);
   const int w = static_cast<int>(camera.width), h = static_cast<int>(camera.height);
   const double fx = pinhole.params[0], fy = pinhole.params[1], cx = pinhole.params[2],
@@ -73,6 +146,7 @@ void ComputeUndistortionMaps(const Camera& camera, cv::Mat* map_x, cv::Mat* map_
                           my.at<double>(row, col) > -0.5 && my.at<double>(row, col) < h - 0.5;
       if (inside && a * d - b * c <= 0) {
         MR_THROW_INPUT << "camera " << camera.camera_id << " (" << CameraModelName(camera.model)
+                       << ", " << DistortionText(camera)
                        << "): the distortion folds over at pixel (" << col << ", " << row
                        << ") of the image (parameters outside the model's valid range); "
                        << "cannot undistort it; run `colmap image_undistorter` instead";

@@ -107,6 +107,36 @@ TEST(Undistortion, KnownPointLandsOnPinholeProjection) {
   std::cout << "max undistorted point error: " << max_error << " px\n";
 }
 
+// Distortion that sends most of the undistorted image outside the distorted
+// one (the refinement would compare black images and "finish" at similarity
+// 0) is refused, naming the camera and the parameter to blame.
+TEST(Undistortion, RefusesImplausibleDistortion) {
+  const std::vector<std::pair<Camera, std::string>> cases = {
+      {MakeCamera(CameraModel::kOpenCV, {250, 250, 160, 120, 5, 0, 0, 0}), "k1 = 5"},
+      {MakeCamera(CameraModel::kRadial, {250, 160, 120, 240, 0}), "k1 = 240"},
+      {MakeCamera(CameraModel::kSimpleRadial, {250, 160, 120, 30}), "k = 30"},
+  };
+  for (const auto& [camera, parameter] : cases) {
+    cv::Mat mx, my;
+    try {
+      ComputeUndistortionMaps(camera, &mx, &my);
+      ADD_FAILURE() << CameraModelName(camera.model) << ": no InputError";
+    } catch (const InputError& e) {
+      const std::string what = e.what();
+      EXPECT_NE(what.find("camera 1 (" + CameraModelName(camera.model)), std::string::npos) << what;
+      EXPECT_NE(what.find("implausible distortion parameter " + parameter), std::string::npos)
+          << what;
+      EXPECT_NE(what.find("would sample outside the distorted image"), std::string::npos) << what;
+    }
+  }
+  // Strong but plausible pincushion and barrel distortion pass.
+  cv::Mat mx, my;
+  ComputeUndistortionMaps(MakeCamera(CameraModel::kOpenCV, {250, 250, 160, 120, 0.3, 0, 0, 0}),
+                          &mx, &my);
+  ComputeUndistortionMaps(MakeCamera(CameraModel::kOpenCV, {250, 250, 160, 120, -0.3, 0, 0, 0}),
+                          &mx, &my);
+}
+
 TEST(Undistortion, RefusesFoldingDistortion) {
   // k1 = -1.5 makes x(1 + k1 r^2) fold back inside the image.
   const Camera camera = MakeCamera(CameraModel::kOpenCV, {250, 250, 160, 120, -1.5, 0, 0, 0});
@@ -115,7 +145,7 @@ TEST(Undistortion, RefusesFoldingDistortion) {
     ComputeUndistortionMaps(camera, &mx, &my);
     ADD_FAILURE() << "no InputError";
   } catch (const InputError& e) {
-    EXPECT_NE(std::string(e.what()).find("camera 1 (OPENCV)"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("camera 1 (OPENCV, k1 = -1.5"), std::string::npos) << e.what();
     EXPECT_NE(std::string(e.what()).find("folds"), std::string::npos) << e.what();
   }
 }
