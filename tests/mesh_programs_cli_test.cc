@@ -21,6 +21,7 @@ const std::string kEvaluator = std::string(MR_BIN_DIR) + "/mesh_evaluator";
 const std::string kInitializer = std::string(MR_BIN_DIR) + "/mesh_initializer";
 const std::string kMiddlebury = std::string(MR_BIN_DIR) + "/middlebury_to_colmap";
 const std::string kRender = std::string(MR_BIN_DIR) + "/mesh_render";
+const std::string kSynthesizer = std::string(MR_BIN_DIR) + "/workspace_synthesizer";
 
 // An octahedron: small, closed, and quick for both programs.
 TriangleMesh Octahedron(double scale) {
@@ -141,6 +142,41 @@ TEST_F(MeshProgramsCli, OtherProgramsWriteConfigOverInputIsRefused) {
   ExpectRefused(kRender + " --input_path " + dir_ + "/m.ply --output_path " + dir_ +
                     "/r.png --side_by_side " + dir_ + "/gt.ply --write_config " + dir_ + "/gt.ply",
                 "refusing to overwrite");
+}
+
+// Every program refuses, before reading its inputs, an output it could not
+// write: in a virtual file system (/proc, /sys; root cannot create files
+// there either), an existing folder where a file is expected, a file where a
+// folder is expected. An existing output is left as it was.
+TEST_F(MeshProgramsCli, UnwritableOutputsAreRefusedBeforeAnyWork) {
+  const std::string m = dir_ + "/m.ply";
+  fs::create_directories(dir_ + "/folder.ply");
+  std::ofstream(dir_ + "/out.ply") << "sentinel";
+  const std::string denoise = kDenoiser + " --input_path " + m + " --output_path ";
+  ExpectRefused(denoise + "/proc/out.ply", "--output_path /proc/out.ply: cannot create a file");
+  ExpectRefused(denoise + "/sys/out.ply", "cannot create a file in folder /sys");
+  ExpectRefused(denoise + dir_ + "/folder.ply", "is a folder");
+  ExpectRefused(denoise + dir_ + "/out.ply --write_config /proc/d.ini",
+                "--write_config /proc/d.ini: cannot create a file in folder /proc");
+  EXPECT_EQ(ReadFileToString(dir_ + "/out.ply"), "sentinel");
+  ExpectRefused(kEvaluator + " --input_path " + m + " --gt_path " + dir_ +
+                    "/gt.ply --write_config /sys/e.ini",
+                "--write_config /sys/e.ini: cannot create a file in folder /sys");
+  // The workspace is never opened (it does not exist): refused first.
+  ExpectRefused(kInitializer + " --workspace_path " + dir_ + "/ws --output_path /proc/hull.ply",
+                "--output_path /proc/hull.ply: cannot create a file");
+  ExpectRefused(kRender + " --input_path " + m + " --view \"0 0\" --output_path /proc/r.png",
+                "--output_path /proc/r.png: cannot create a file");
+  ExpectRefused(kRender + " --input_path " + m + " --view \"0 0\" --output_path " + dir_ +
+                    "/folder.ply",
+                "is a folder");
+  ExpectRefused(kMiddlebury + " --input_path " + dir_ + "/temple --output_path /proc/mb",
+                "--output_path /proc/mb: cannot create files in folder /proc");
+  ExpectRefused(kMiddlebury + " --input_path " + dir_ + "/temple --output_path " + m + "/ws",
+                "is not a folder");
+  ExpectRefused(kSynthesizer + " --output_path /proc/synth/deeper",
+                "--output_path /proc/synth/deeper: cannot create files in folder /proc");
+  ExpectRefused(kSynthesizer + " --output_path " + m, "is a file; expected a folder");
 }
 
 }  // namespace

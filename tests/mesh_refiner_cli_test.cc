@@ -263,6 +263,29 @@ TEST_F(MeshRefinerCli, OutputOverAnInputOrWithAnUnknownExtensionIsRefused) {
   }
 }
 
+// An output that cannot be written is refused before the workspace is read:
+// a folder in a virtual file system (/proc, /sys: no file can be created
+// there, even by root), an existing folder, a missing folder.
+TEST_F(MeshRefinerCli, UnwritableOutputIsRefusedBeforeAnyWork) {
+  WriteSentinelOutput();
+  fs::create_directories(dir_ + "/folder.ply");
+  for (const auto& [out, message] : std::vector<std::pair<std::string, std::string>>{
+           {"/proc/refined.ply", "cannot create a file in folder /proc"},
+           {"/sys/refined.ply", "cannot create a file in folder /sys"},
+           {dir_ + "/folder.ply", "is a folder"},
+           {dir_ + "/nope/refined.ply", "does not exist"}}) {
+    const CommandResult r =
+        RunCommand(kRefiner + " --workspace_path " + dir_ + " --output_path " + out + kFast);
+    ExpectRefused(r, "--output_path " + out + ": " , dir_ + "/meshed-refined.ply", "sentinel");
+    EXPECT_NE(r.output.find(message), std::string::npos) << r.output;
+    EXPECT_EQ(r.output.find("Read "), std::string::npos) << "work was done:\n" << r.output;
+  }
+  const CommandResult r =
+      RunCommand(kRefiner + " --workspace_path " + dir_ + " --write_config /proc/refine.ini");
+  ExpectRefused(r, "--write_config /proc/refine.ini: cannot create a file in folder /proc",
+                dir_ + "/meshed-refined.ply", "sentinel");
+}
+
 // --output_path x.obj writes OBJ (with the vertex colours), not PLY bytes.
 TEST_F(MeshRefinerCli, ObjOutput) {
   const std::string out = dir_ + "/refined.obj";

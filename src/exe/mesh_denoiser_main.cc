@@ -46,6 +46,7 @@ int Run(int argc, char** argv) {
     }
   }
   RefuseOutputOverInput("--output_path", output_path, {input_path});
+  CheckOutputFile("--output_path", output_path);
   TriangleMesh mesh = ReadMesh(input_path);
   MR_LOG(INFO) << "Read " << input_path << ": " << mesh.NumVertices() << " vertices, "
                << mesh.NumFaces() << " faces";

@@ -74,6 +74,13 @@ int main(int argc, char** argv) {
     }
 #endif
     if (output_path.empty()) output_path = mr::JoinPaths(workspace_path, "meshed-visualhull.ply");
+    {
+      std::vector<std::string> inputs = mr::WorkspaceInputPaths(workspace_path);
+      inputs.push_back(mr::JoinPaths(workspace_path, "holdout.txt"));
+      inputs.push_back(mr::JoinPaths(workspace_path, "silhouette_images.txt"));
+      mr::RefuseOutputOverInput("--output_path", output_path, inputs);
+    }
+    mr::CheckOutputFile("--output_path", output_path);
 
     const mr::Workspace ws = mr::OpenWorkspace(workspace_path);
     std::set<std::string> holdout, good;

@@ -91,6 +91,7 @@ int Run(int argc, char** argv) {
     MR_THROW_INPUT << "--output_path " << output_path << ": unsupported extension '" << output_ext
                    << "' (expected .ply or .obj)";
   }
+  CheckOutputFile("--output_path", output_path);
 
   WorkspaceOptions ws_options;
   ws_options.mask_path = mask_path;
@@ -105,11 +106,6 @@ int Run(int argc, char** argv) {
     }
   }
   RefuseOutputOverInput("--output_path", output_path, {input_path});
-  const std::string output_dir = GetParentDir(output_path);
-  if (!output_dir.empty() && !ExistsDir(output_dir)) {
-    MR_THROW_INPUT << "--output_path " << output_path << ": folder " << output_dir
-                   << " does not exist";
-  }
 
   const std::set<std::string> holdout =
       holdout_path.empty() ? std::set<std::string>{} : [&] {

@@ -17,6 +17,7 @@
 #include "init/mesh_picture.h"
 #include "render/renderer.h"
 #include "util/error.h"
+#include "util/file.h"
 #include "util/logging.h"
 #include "util/options.h"
 #include "util/program.h"
@@ -93,6 +94,8 @@ int main(int argc, char** argv) {
       MR_THROW_INPUT << "--image_name needs --workspace_path";
     }
     if (width < 0 || height < 0) MR_THROW_INPUT << "--width/--height must be positive";
+    mr::RefuseOutputOverInput("--output_path", output_path, {input_path, side_by_side});
+    mr::CheckOutputFile("--output_path", output_path);
 
     const mr::TriangleMesh mesh = LoadMesh(input_path);
     mr::TriangleMesh second;

@@ -9,6 +9,7 @@
 
 #include "init/middlebury.h"
 #include "util/error.h"
+#include "util/file.h"
 #include "util/logging.h"
 #include "util/options.h"
 #include "util/program.h"
@@ -40,6 +41,7 @@ int main(int argc, char** argv) {
     manager.SetInputPaths([&] { return std::vector<std::string>{input_path}; });
     if (!manager.Parse(argc, argv)) return 0;
     if (verbose) mr::SetLogLevel(mr::LogLevel::kVerbose);
+    mr::CheckOutputFolder("--output_path", output_path);
     const mr::MiddleburyConversionSummary summary =
         mr::ConvertMiddlebury(input_path, output_path, options);
     std::string held;

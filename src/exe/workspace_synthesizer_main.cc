@@ -92,6 +92,7 @@ int main(int argc, char** argv) {
     if (!options.Parse(argc, argv)) return 0;
     if (verbose) mr::SetLogLevel(mr::LogLevel::kVerbose);
     o.Check();
+    mr::CheckOutputFolder("--output_path", o.output_path);
     mr::CreateDirIfNotExists(o.output_path);
     options.WriteConfig(mr::JoinPaths(o.output_path, "workspace_synthesizer.ini"));
     const mr::SynthesizerSummary summary = mr::SynthesizeWorkspace(o);
