@@ -38,7 +38,10 @@ int ParseHeaderField(const std::string& path, const std::string& data, size_t* p
 }  // namespace
 
 DenseArray ReadDenseArray(const std::string& path) {
-  const std::string data = ReadFileToString(path);
+  return ReadDenseArrayData(path, ReadFileToString(path));
+}
+
+DenseArray ReadDenseArrayData(const std::string& path, const std::string& data) {
   DenseArray array;
   size_t pos = 0;
   array.width = ParseHeaderField(path, data, &pos, "width", kMaxSide);
@@ -77,7 +80,11 @@ void WriteDenseArray(const std::string& path, const DenseArray& array) {
 }
 
 std::vector<std::vector<uint32_t>> ReadFusedVisibility(const std::string& path) {
-  const std::string data = ReadFileToString(path);
+  return ReadFusedVisibilityData(path, ReadFileToString(path));
+}
+
+std::vector<std::vector<uint32_t>> ReadFusedVisibilityData(const std::string& path,
+                                                           const std::string& data) {
   size_t pos = 0;
   auto read = [&](auto* value, const char* what) {
     if (data.size() - pos < sizeof(*value)) {

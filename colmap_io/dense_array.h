@@ -25,11 +25,16 @@ struct DenseArray {
 
 // Throws InputError on a malformed header, a truncated body or non-finite data.
 DenseArray ReadDenseArray(const std::string& path);
+// The same from the file's bytes `data`; `path` only names them in errors
+// (in-memory data, the fuzz harnesses). Likewise ReadFusedVisibilityData.
+DenseArray ReadDenseArrayData(const std::string& path, const std::string& data);
 // Writes atomically.
 void WriteDenseArray(const std::string& path, const DenseArray& array);
 
 // fused.ply.vis: u64 count, then per point u32 n and n u32 image indices.
 std::vector<std::vector<uint32_t>> ReadFusedVisibility(const std::string& path);
+std::vector<std::vector<uint32_t>> ReadFusedVisibilityData(const std::string& path,
+                                                           const std::string& data);
 void WriteFusedVisibility(const std::string& path,
                           const std::vector<std::vector<uint32_t>>& visibility);
 

@@ -85,7 +85,11 @@ cv::Mat ReadImageFile(const std::string& path, int flags, const std::string& wha
     MR_THROW_INPUT << path << ": " << what << " is not a file (expected an image file"
                    << (ExistsDir(path) ? ", found a folder)" : ")");
   }
-  const std::string data = ReadFileToString(path);
+  return DecodeImageFile(path, ReadFileToString(path), flags, what);
+}
+
+cv::Mat DecodeImageFile(const std::string& path, const std::string& data, int flags,
+                        const std::string& what) {
   if (data.empty()) MR_THROW_INPUT << path << ": " << what << " file is empty";
   if (data.size() > static_cast<size_t>(std::numeric_limits<int>::max())) {
     MR_THROW_INPUT << path << ": " << what << " file of " << data.size()

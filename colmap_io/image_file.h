@@ -27,4 +27,9 @@ void CheckImageComplete(const std::string& path, const std::string& data);
 // missing, is not a regular file, is truncated or cannot be decoded.
 cv::Mat ReadImageFile(const std::string& path, int flags, const std::string& what = "image");
 
+// ReadImageFile after the file was read: checks and decodes its bytes `data`
+// (empty, too large, truncated, undecodable: InputError naming `path`).
+cv::Mat DecodeImageFile(const std::string& path, const std::string& data, int flags,
+                        const std::string& what = "image");
+
 }  // namespace mr

@@ -37,8 +37,9 @@ bool TokenIs(const std::pair<const char*, const char*>& token, const char* word)
 
 }  // namespace
 
-TriangleMesh ReadObj(const std::string& path) {
-  const std::string data = ReadFileToString(path);
+TriangleMesh ReadObj(const std::string& path) { return ReadObjData(path, ReadFileToString(path)); }
+
+TriangleMesh ReadObjData(const std::string& path, const std::string& data) {
   std::vector<double> positions;
   std::vector<double> colors;
   std::vector<int> triangles;

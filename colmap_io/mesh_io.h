@@ -25,6 +25,8 @@ TriangleMesh ReadMesh(const std::string& path);
 void WriteMesh(const std::string& path, const TriangleMesh& mesh);
 
 TriangleMesh ReadObj(const std::string& path);
+// ReadObj from the file's bytes `data`; `path` only names them in errors.
+TriangleMesh ReadObjData(const std::string& path, const std::string& data);
 void WriteObj(const std::string& path, const TriangleMesh& mesh);
 
 }  // namespace mr

@@ -410,8 +410,9 @@ int64_t VerticesBeforeFaces(const std::string& data, const Header& header, int v
 
 }  // namespace
 
-TriangleMesh ReadPly(const std::string& path) {
-  const std::string data = ReadFileToString(path);
+TriangleMesh ReadPly(const std::string& path) { return ReadPlyData(path, ReadFileToString(path)); }
+
+TriangleMesh ReadPlyData(const std::string& path, const std::string& data) {
   const Header header = ParseHeader(path, data);
 
   int vertex_element = -1;

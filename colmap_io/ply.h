@@ -32,6 +32,9 @@ enum class PlyFormat { kBinaryLittleEndian, kBinaryBigEndian, kAscii };
 
 // Reads a mesh (a point cloud reads as a mesh with no faces).
 TriangleMesh ReadPly(const std::string& path);
+// The same from the file's bytes `data`; `path` only names them in errors
+// (in-memory data, the fuzz harnesses).
+TriangleMesh ReadPlyData(const std::string& path, const std::string& data);
 
 // Writes `mesh` atomically (temporary file in the same folder, then rename).
 // N, C and values are written when non-empty. Faces are written as

@@ -127,7 +127,7 @@ CameraModel ModelFromId(const std::string& path, uint32_t camera_id, int64_t mod
 
 class BinaryCursor {
  public:
-  explicit BinaryCursor(std::string path) : path_(std::move(path)), data_(ReadFileToString(path_)) {}
+  BinaryCursor(const std::string& path, const std::string& data) : path_(path), data_(data) {}
 
   size_t Remaining() const { return data_.size() - pos_; }
 
@@ -176,15 +176,15 @@ class BinaryCursor {
   const std::string& path() const { return path_; }
 
  private:
-  std::string path_;
-  std::string data_;
+  const std::string& path_;
+  const std::string& data_;
   size_t pos_ = 0;
 };
 
 static_assert(sizeof(double) == 8 && sizeof(float) == 4, "IEEE types expected");
 
-void ReadCamerasBinary(const std::string& path, Reconstruction* model) {
-  BinaryCursor in(path);
+void ReadCamerasBinary(const std::string& path, const std::string& data, Reconstruction* model) {
+  BinaryCursor in(path, data);
   const uint64_t n = in.ReadCount("number of cameras", 24 + 3 * 8);
   for (uint64_t i = 0; i < n; ++i) {
     Camera camera;
@@ -203,8 +203,8 @@ void ReadCamerasBinary(const std::string& path, Reconstruction* model) {
   in.ExpectEnd();
 }
 
-void ReadImagesBinary(const std::string& path, Reconstruction* model) {
-  BinaryCursor in(path);
+void ReadImagesBinary(const std::string& path, const std::string& data, Reconstruction* model) {
+  BinaryCursor in(path, data);
   const uint64_t n = in.ReadCount("number of images", 4 + 7 * 8 + 4 + 1 + 8);
   for (uint64_t i = 0; i < n; ++i) {
     Image image;
@@ -229,8 +229,8 @@ void ReadImagesBinary(const std::string& path, Reconstruction* model) {
   in.ExpectEnd();
 }
 
-void ReadPoints3DBinary(const std::string& path, Reconstruction* model) {
-  BinaryCursor in(path);
+void ReadPoints3DBinary(const std::string& path, const std::string& data, Reconstruction* model) {
+  BinaryCursor in(path, data);
   const uint64_t n = in.ReadCount("number of points3D", 8 + 24 + 3 + 8 + 8);
   for (uint64_t i = 0; i < n; ++i) {
     Point3D point;
@@ -330,8 +330,8 @@ constexpr int64_t kU32Max = std::numeric_limits<uint32_t>::max();
 
 class LineReader {
  public:
-  explicit LineReader(const std::string& path) : path_(path) {
-    std::istringstream in(ReadFileToString(path));
+  explicit LineReader(const std::string& data) {
+    std::istringstream in(data);
     std::string line;
     while (std::getline(in, line)) {
       if (!line.empty() && line.back() == '\r') line.pop_back();
@@ -359,13 +359,12 @@ class LineReader {
   }
 
  private:
-  std::string path_;
   std::vector<std::string> lines_;
   size_t pos_ = 0;
 };
 
-void ReadCamerasText(const std::string& path, Reconstruction* model) {
-  LineReader reader(path);
+void ReadCamerasText(const std::string& path, const std::string& data, Reconstruction* model) {
+  LineReader reader(data);
   std::string line;
   int line_no = 0;
   while (reader.NextData(&line, &line_no)) {
@@ -388,8 +387,8 @@ void ReadCamerasText(const std::string& path, Reconstruction* model) {
   }
 }
 
-void ReadImagesText(const std::string& path, Reconstruction* model) {
-  LineReader reader(path);
+void ReadImagesText(const std::string& path, const std::string& data, Reconstruction* model) {
+  LineReader reader(data);
   std::string line;
   int line_no = 0;
   while (reader.NextData(&line, &line_no)) {
@@ -425,8 +424,8 @@ void ReadImagesText(const std::string& path, Reconstruction* model) {
   }
 }
 
-void ReadPoints3DText(const std::string& path, Reconstruction* model) {
-  LineReader reader(path);
+void ReadPoints3DText(const std::string& path, const std::string& data, Reconstruction* model) {
+  LineReader reader(data);
   std::string line;
   int line_no = 0;
   while (reader.NextData(&line, &line_no)) {
@@ -475,20 +474,38 @@ void CheckWritable(const std::string& dir, const Reconstruction& model) {
 
 }  // namespace
 
-Reconstruction ReadSparseModelBinary(const std::string& dir) {
+void ReadSparseModelFile(const std::string& path, const std::string& data,
+                         Reconstruction* model) {
+  const std::string name = GetFileName(path);
+  if (name == "cameras.bin") return ReadCamerasBinary(path, data, model);
+  if (name == "images.bin") return ReadImagesBinary(path, data, model);
+  if (name == "points3D.bin") return ReadPoints3DBinary(path, data, model);
+  if (name == "cameras.txt") return ReadCamerasText(path, data, model);
+  if (name == "images.txt") return ReadImagesText(path, data, model);
+  if (name == "points3D.txt") return ReadPoints3DText(path, data, model);
+  MR_THROW_INPUT << path << ": not a sparse model file (expected cameras, images or points3D "
+                 << "with .bin or .txt)";
+}
+
+namespace {
+
+Reconstruction ReadSparseModelFiles(const std::string& dir, const char* ext) {
   Reconstruction model;
-  ReadCamerasBinary(JoinPaths(dir, "cameras.bin"), &model);
-  ReadImagesBinary(JoinPaths(dir, "images.bin"), &model);
-  ReadPoints3DBinary(JoinPaths(dir, "points3D.bin"), &model);
+  for (const char* name : {"cameras", "images", "points3D"}) {
+    const std::string path = JoinPaths(dir, std::string(name) + ext);
+    ReadSparseModelFile(path, ReadFileToString(path), &model);
+  }
   return model;
 }
 
+}  // namespace
+
+Reconstruction ReadSparseModelBinary(const std::string& dir) {
+  return ReadSparseModelFiles(dir, ".bin");
+}
+
 Reconstruction ReadSparseModelText(const std::string& dir) {
-  Reconstruction model;
-  ReadCamerasText(JoinPaths(dir, "cameras.txt"), &model);
-  ReadImagesText(JoinPaths(dir, "images.txt"), &model);
-  ReadPoints3DText(JoinPaths(dir, "points3D.txt"), &model);
-  return model;
+  return ReadSparseModelFiles(dir, ".txt");
 }
 
 Reconstruction ReadSparseModel(const std::string& dir) {

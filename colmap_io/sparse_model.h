@@ -72,6 +72,12 @@ struct Reconstruction {
 Reconstruction ReadSparseModel(const std::string& dir);
 Reconstruction ReadSparseModelBinary(const std::string& dir);
 Reconstruction ReadSparseModelText(const std::string& dir);
+// One of the six files from its bytes `data`: the file name of `path`
+// (cameras.bin, images.txt, ...) says which, and names it in errors. `model`
+// must already hold what the file refers to (cameras for images, images for
+// points3D); the file's records are added to it. Same checks as above.
+void ReadSparseModelFile(const std::string& path, const std::string& data,
+                         Reconstruction* model);
 
 // Write the three files atomically into an existing folder. Text files use
 // max_digits10 digits, so text round trips are exact.

@@ -130,7 +130,10 @@ void OptionManager::Set(const std::string& name, const std::string& value,
 }
 
 void OptionManager::ReadConfig(const std::string& path) {
-  const std::string text = ReadFileToString(path);
+  ReadConfigData(path, ReadFileToString(path));
+}
+
+void OptionManager::ReadConfigData(const std::string& path, const std::string& text) {
   std::istringstream in(text);
   std::string line, section;
   int line_no = 0;

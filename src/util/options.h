@@ -41,6 +41,8 @@ class OptionManager {
 
   // Reads an .ini file (sections map to "Section." prefixes). Throws InputError.
   void ReadConfig(const std::string& path);
+  // The same from the file's text; `path` only names it in errors.
+  void ReadConfigData(const std::string& path, const std::string& text);
   // Writes all options as an .ini file (atomically).
   void WriteConfig(const std::string& path) const;
   std::string Usage() const;
