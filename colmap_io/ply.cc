@@ -2,9 +2,11 @@
 
 #include <algorithm>
 #include <cctype>
+#include <cerrno>
 #include <cmath>
 #include <cstdio>
 #include <cstring>
+#include <iomanip>
 #include <limits>
 #include <ostream>
 #include <sstream>
@@ -178,6 +180,24 @@ class BodyReader {
 
   bool swap() const { return swap_; }
 
+  // Reads the length of a list (count of `type`). Every item takes at least
+  // one byte (binary) or character (ASCII), so a length beyond the rest of
+  // the file is refused before any loop or conversion to an integer.
+  int64_t ReadListLength(ScalarType type, const Element& element, int64_t record) {
+    const double n = Read(type, element, record);
+    if (n < 0) {
+      MR_THROW_INPUT << path_ << ": negative list length " << n << " in element '"
+                     << element.name << "' record " << record;
+    }
+    if (n > static_cast<double>(end_ - pos_)) {
+      MR_THROW_INPUT << path_ << ": truncated PLY body: element '" << element.name << "' record "
+                     << record << " has a list of " << std::setprecision(15) << n
+                     << " values but only " << (end_ - pos_)
+                     << (binary() ? " bytes" : " characters") << " are left";
+    }
+    return static_cast<int64_t>(n);
+  }
+
   // Bytes (binary) or non-space characters (ASCII) left after the body.
   bool HasTrailingData() const {
     if (binary()) return pos_ != end_;
@@ -283,8 +303,9 @@ Header ParseHeader(const std::string& path, const std::string& data) {
       std::string count;
       in >> element.name >> count;
       char* end = nullptr;
+      errno = 0;
       const long long n = std::strtoll(count.c_str(), &end, 10);
-      if (element.name.empty() || count.empty() || *end != '\0' || n < 0) {
+      if (element.name.empty() || count.empty() || *end != '\0' || n < 0 || errno == ERANGE) {
         MR_THROW_INPUT << path << ": malformed element line " << line_number << ": '" << line
                        << "' (expected 'element <name> <count>')";
       }
@@ -488,9 +509,10 @@ TriangleMesh ReadPlyData(const std::string& path, const std::string& data) {
       }
     }
     if (available < min_size) {
-      MR_THROW_INPUT << path << ": truncated PLY body: the header needs at least "
-                     << static_cast<int64_t>(min_size) << (ascii ? " characters" : " bytes")
-                     << " after the header, the file has " << static_cast<int64_t>(available)
+      // min_size may exceed every integer type (counts up to 2^63 - 1).
+      MR_THROW_INPUT << path << ": truncated PLY body: the header needs at least " << std::fixed
+                     << std::setprecision(0) << min_size << (ascii ? " characters" : " bytes")
+                     << " after the header, the file has " << data.size() - header.body_offset
                      << " (" << room << ")";
     }
   }
@@ -527,13 +549,8 @@ TriangleMesh ReadPlyData(const std::string& path, const std::string& data) {
           for (size_t k = 0; k < element.properties.size(); ++k) {
             const Property& prop = element.properties[k];
             if (prop.is_list) {
-              const double n = reader.Read(prop.count_type, element, i);
-              if (n < 0) {
-                MR_THROW_INPUT << path << ": negative list length " << n << " in vertex " << i;
-              }
-              for (int64_t j = 0; j < static_cast<int64_t>(n); ++j) {
-                reader.Read(prop.type, element, i);
-              }
+              const int64_t n = reader.ReadListLength(prop.count_type, element, i);
+              for (int64_t j = 0; j < n; ++j) reader.Read(prop.type, element, i);
               record_values[k] = 0;
             } else {
               record_values[k] = reader.Read(prop.type, element, i);
@@ -573,11 +590,7 @@ TriangleMesh ReadPlyData(const std::string& path, const std::string& data) {
               reader.Read(prop.type, element, i);
               continue;
             }
-            const double n_value = reader.Read(prop.count_type, element, i);
-            if (n_value < 0) {
-              MR_THROW_INPUT << path << ": negative list length " << n_value << " in face " << i;
-            }
-            const int64_t n = static_cast<int64_t>(n_value);
+            const int64_t n = reader.ReadListLength(prop.count_type, element, i);
             if (static_cast<int>(k) != face_list) {
               for (int64_t j = 0; j < n; ++j) reader.Read(prop.type, element, i);
               continue;
@@ -628,17 +641,12 @@ TriangleMesh ReadPlyData(const std::string& path, const std::string& data) {
         }
         continue;
       }
+      if (element.properties.empty()) continue;  // nothing to read, however many records
       for (int64_t i = 0; i < element.count; ++i) {
         for (const Property& prop : element.properties) {
           if (prop.is_list) {
-            const double n = reader.Read(prop.count_type, element, i);
-            if (n < 0) {
-              MR_THROW_INPUT << path << ": negative list length " << n << " in element '"
-                             << element.name << "' record " << i;
-            }
-            for (int64_t j = 0; j < static_cast<int64_t>(n); ++j) {
-              reader.Read(prop.type, element, i);
-            }
+            const int64_t n = reader.ReadListLength(prop.count_type, element, i);
+            for (int64_t j = 0; j < n; ++j) reader.Read(prop.type, element, i);
           } else {
             reader.Read(prop.type, element, i);
           }

@@ -388,6 +388,56 @@ TEST(PlyBadInput, HugeCountInHeader) {
   ExpectReadError(path, "too many vertices");
 }
 
+// Found by fuzz/ply_fuzzer (the input is fuzz/corpus/ply/regression_huge_count):
+// an element count beyond long long was read as LLONG_MAX, and the bytes the
+// header then needs were converted to int64 for the message (undefined
+// behaviour). Lengths of ASCII lists (3e30 reads as an integer) were
+// converted the same way.
+TEST(PlyBadInput, CountsBeyondIntegerRange) {
+  const std::string header =
+      "ply\nformat ascii 1.0\nelement vertex 0\nproperty float x\nproperty float y\n"
+      "property float z\n";
+  ExpectInputError(
+      [&] {
+        ReadPlyData("a.ply", header + "element face 99999999999999999999\n"
+                                      "property list uchar int vertex_indices\nend_header\n");
+      },
+      {"a.ply", "malformed element line"});
+  ExpectInputError(
+      [&] {
+        ReadPlyData("b.ply", header + "element face 9223372036854775807\n"
+                                      "property list uchar int vertex_indices\nend_header\n");
+      },
+      {"b.ply", "truncated PLY body", "needs at least 18446744073709551616 characters"});
+  ExpectInputError(
+      [&] { ReadPlyData("c.ply", std::string(kAsciiHeader) + "0 0 0\n1 0 0\n0 1 0\n3e30 0 1 2\n"); },
+      {"c.ply", "truncated PLY body", "element 'face' record 0 has a list of 3e+30 values"});
+  // Binary: a list length the rest of the file cannot hold.
+  std::string binary =
+      "ply\nformat binary_little_endian 1.0\nelement vertex 0\nproperty float x\n"
+      "property float y\nproperty float z\nelement face 1\n"
+      "property list uint int vertex_indices\nend_header\n";
+  binary += std::string("\xff\xff\xff\xff", 4) + std::string(12, '\0');
+  ExpectInputError([&] { ReadPlyData("d.ply", binary); },
+                   {"d.ply", "record 0 has a list of 4294967295 values but only 12 bytes"});
+  // An ASCII element without properties is skipped, whatever its count.
+  const TriangleMesh mesh = ReadPlyData(
+      "e.ply", header + "element nothing 9223372036854775807\nend_header\n");
+  EXPECT_EQ(mesh.NumVertices(), 0);
+}
+
+TEST(Ply, ReadPlyDataMatchesReadPly) {
+  const std::string path = TempPath("data.ply");
+  WritePly(path, MakeMesh(true, true, true), PlyFormat::kBinaryBigEndian);
+  const TriangleMesh a = ReadPly(path);
+  const TriangleMesh b = ReadPlyData(path, ReadRaw(path));
+  EXPECT_EQ(a.V, b.V);
+  EXPECT_EQ(a.F, b.F);
+  EXPECT_EQ(a.N, b.N);
+  EXPECT_EQ(a.C, b.C);
+  EXPECT_EQ(a.values, b.values);
+}
+
 TEST(Ply, WriteIsAtomicOnBadFolder) {
   EXPECT_THROW(WritePly(TempPath("no_such_dir/mesh.ply"), MakeMesh(false, false, false)),
                InputError);
