@@ -87,6 +87,7 @@ class MeshRefinerCli : public ::testing::Test {
 TEST_F(MeshRefinerCli, Nominal) {
   const CommandResult r = RunCommand(kRefiner + " --workspace_path " + dir_ + kFast);
   ASSERT_EQ(r.exit_code, 0) << r.output;
+  EXPECT_EQ(r.output.find("probably meaningless"), std::string::npos) << r.output;
   const TriangleMesh out = ReadPly(dir_ + "/meshed-refined.ply");
   EXPECT_GT(out.NumFaces(), 100);
   EXPECT_EQ(out.C.rows(), out.NumVertices()) << "vertex colours expected";
@@ -381,6 +382,67 @@ TEST_F(MeshRefinerCli, SigtermDuringTheWriteRemovesTheTemporary) {
   fs::remove(tmp);
   EXPECT_TRUE(SentinelIntact());
   for (const auto& name : ListFiles(dir_)) EXPECT_EQ(name.find(".tmp."), std::string::npos) << name;
+}
+
+// A handful of triangles is not a surface to refine: a one-triangle mesh and
+// a cube (12 faces) are refused with the count, before any rendering.
+TEST_F(MeshRefinerCli, TooFewFacesAreRefused) {
+  WriteSentinelOutput();
+  TriangleMesh triangle;
+  triangle.V.resize(3, 3);
+  triangle.V << 0, 0, 0, 0.5, 0, 0, 0, 0.5, 0;
+  triangle.F.resize(1, 3);
+  triangle.F << 0, 1, 2;
+  WritePly(dir_ + "/meshed-poisson.ply", triangle);
+  ExpectRefused(RunCommand(kRefiner + " --workspace_path " + dir_ + kFast),
+                "the mesh has 1 faces; at least 20", dir_ + "/meshed-refined.ply", "sentinel");
+  TriangleMesh cube;
+  cube.V.resize(8, 3);
+  cube.V << -1, -1, -1, 1, -1, -1, 1, 1, -1, -1, 1, -1, -1, -1, 1, 1, -1, 1, 1, 1, 1, -1, 1, 1;
+  cube.V *= 0.5;
+  cube.F.resize(12, 3);
+  cube.F << 0, 2, 1, 0, 3, 2, 4, 5, 6, 4, 6, 7, 0, 1, 5, 0, 5, 4, 2, 3, 7, 2, 7, 6, 1, 2, 6, 1, 6,
+      5, 0, 4, 7, 0, 7, 3;
+  WritePly(dir_ + "/meshed-poisson.ply", cube);
+  const CommandResult r = RunCommand(kRefiner + " --workspace_path " + dir_ + kFast);
+  ExpectRefused(r, "the mesh has 12 faces; at least 20", dir_ + "/meshed-refined.ply", "sentinel");
+  EXPECT_EQ(r.output.find("Renderer:"), std::string::npos) << "work was done:\n" << r.output;
+}
+
+// --Refine.num_levels 6 on 160x120 images: the coarse levels would remesh
+// the sphere to a few faces, which the finer levels cannot undo; they are
+// skipped with a line each, and the result keeps its shape.
+TEST_F(MeshRefinerCli, CoarseLevelsWithTooFewFacesAreSkipped) {
+  const CommandResult r = RunCommand(kRefiner + " --workspace_path " + dir_ +
+                                     " --Refine.num_levels 6 --Refine.iterations_per_level 1"
+                                     " --Refine.target_edge_px 4");
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  EXPECT_NE(r.output.find("Level 5 skipped: its mesh would have"), std::string::npos) << r.output;
+  EXPECT_NE(r.output.find("schedule: level 5 skipped"), std::string::npos) << r.output;
+  EXPECT_EQ(r.output.find("Level 5: "), std::string::npos) << "level 5 ran:\n" << r.output;
+  const TriangleMesh out = ReadPly(dir_ + "/meshed-refined.ply");
+  EXPECT_GT(out.NumFaces(), 500);
+  // Still the unit sphere: every vertex within 10 % of radius 1.
+  const Eigen::VectorXd radius = out.V.rowwise().norm();
+  EXPECT_GT(radius.minCoeff(), 0.9);
+  EXPECT_LT(radius.maxCoeff(), 1.1);
+  EXPECT_EQ(r.output.find("probably meaningless"), std::string::npos) << r.output;
+}
+
+// Images that do not agree with each other through the mesh (noise): the
+// run finishes, but a WARNING line says that the result means nothing.
+TEST_F(MeshRefinerCli, MeaninglessResultIsFlagged) {
+  cv::RNG rng(7);
+  for (const auto& name : ListFiles(dir_ + "/images")) {
+    const cv::Mat image = cv::imread(dir_ + "/images/" + name, cv::IMREAD_GRAYSCALE);
+    cv::Mat noise(image.size(), CV_8U);
+    rng.fill(noise, cv::RNG::UNIFORM, 0, 256);
+    cv::imwrite(dir_ + "/images/" + name, noise);
+  }
+  const CommandResult r = RunCommand(kRefiner + " --workspace_path " + dir_ + kFast);
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  EXPECT_NE(r.output.find("WARNING: the final mean similarity is"), std::string::npos) << r.output;
+  EXPECT_NE(r.output.find("probably meaningless"), std::string::npos) << r.output;
 }
 
 TEST_F(MeshRefinerCli, BadOptionNamesTheField) {

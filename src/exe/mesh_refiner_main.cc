@@ -27,6 +27,28 @@
 namespace mr {
 namespace {
 
+// Fewer input faces than this are refused: a handful of triangles cannot
+// stand for a surface seen in images (a one-triangle "mesh" refines to
+// similarity -0.01).
+constexpr int kMinInputFaces = 20;
+
+// A final mean similarity (plain ZNCC of all view pairs through the mesh) at
+// or below this is reported as a result that probably means nothing. The
+// lowest input similarities in docs/results.md are about 0.2 (fandisk-shading
+// 0.19, the dino's visual hull 0.21); wrong distortion parameters, a mesh of
+// another scene or a collapsed mesh score about 0.
+constexpr double kMeaninglessSimilarity = 0.05;
+
+void WarnIfMeaningless(const RefineSummary& summary) {
+  if (summary.final_similarity > kMeaninglessSimilarity) return;
+  MR_LOG(WARNING) << "WARNING: the final mean similarity is " << summary.final_similarity
+                  << " (initial " << summary.initial_similarity << ", " << summary.final_faces
+                  << " faces), at most " << kMeaninglessSimilarity
+                  << ": the images do not agree with each other through the mesh, so the result "
+                     "is probably meaningless. Check the cameras (distortion parameters), that "
+                     "the mesh belongs to these images, and --Refine.num_levels";
+}
+
 // Prints the dry-run summary of a workspace and mesh.
 void PrintSummary(const Workspace& workspace, const ViewSource& source, const TriangleMesh& mesh,
                   const std::string& input_path) {
@@ -120,6 +142,11 @@ int Run(int argc, char** argv) {
   if (mesh.NumFaces() == 0) {
     MR_THROW_INPUT << input_path << ": the mesh has no faces (a point cloud cannot be refined)";
   }
+  if (mesh.NumFaces() < kMinInputFaces) {
+    MR_THROW_INPUT << input_path << ": the mesh has " << mesh.NumFaces()
+                   << " faces; at least " << kMinInputFaces
+                   << " are needed for a refinement to mean anything (is it the right file?)";
+  }
   if (dry_run) {
     PrintSummary(workspace, source, mesh, input_path);
     return 0;
@@ -154,6 +181,7 @@ int Run(int argc, char** argv) {
   WriteMesh(output_path, mesh);
   MR_LOG(INFO) << "Wrote " << output_path;
   std::cout << summary.FullReport();
+  WarnIfMeaningless(summary);
   if (!holdout_views.empty()) {
     const double after = PhotoConsistency(all_views, holdout_views, mesh.V, mesh.F, &renderer);
     std::printf("Held-out photo-consistency (mean ZNCC, %zu views): %.4f -> %.4f\n",

@@ -4,6 +4,7 @@
 #include <cmath>
 #include <set>
 
+#include "geometry/mesh.h"
 #include "util/error.h"
 
 namespace mr {
@@ -91,6 +92,15 @@ std::vector<std::vector<int>> SelectNeighbors(const std::vector<PinholeView>& vi
 
 // Median pixel footprint (world units per pixel) of the mesh vertices over
 // the views that see them (facing the camera, inside the image).
+int RemeshedFaceCount(const std::vector<PinholeView>& views, const Eigen::MatrixXd& V,
+                      const Eigen::MatrixXi& F, double edge_px, int max_faces) {
+  const double footprint = MedianFootprint(views, V, VertexNormals(V, F));
+  if (!(footprint > 0)) return 0;
+  const double edge = edge_px * footprint;
+  const double faces = FaceAreas(V, F).sum() / (std::sqrt(3.0) / 4.0 * edge * edge);
+  return static_cast<int>(std::min<double>(faces, max_faces));
+}
+
 double MedianFootprint(const std::vector<PinholeView>& views, const Eigen::MatrixXd& V,
                        const Eigen::MatrixXd& N) {
   std::vector<double> footprints;

@@ -43,4 +43,11 @@ std::vector<std::pair<int, int>> NeighborPairs(const std::vector<std::vector<int
 double MedianFootprint(const std::vector<PinholeView>& views, const Eigen::MatrixXd& V,
                        const Eigen::MatrixXd& N);
 
+// Faces of an isotropic mesh of the surface (V, F) with edges of `edge_px`
+// median pixel footprints in `views` (area / (sqrt(3)/4 e^2)), at most
+// `max_faces`: what remeshing for a pyramid level gives. 0 if no view sees
+// the surface.
+int RemeshedFaceCount(const std::vector<PinholeView>& views, const Eigen::MatrixXd& V,
+                      const Eigen::MatrixXi& F, double edge_px, int max_faces);
+
 }  // namespace mr
