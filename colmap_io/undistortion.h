@@ -9,7 +9,7 @@
 // the distorted image at CameraImageFromWorld(distorted, normalized ray).
 // Pixels whose source lies outside the distorted image are black (masks: 0).
 // Models whose distortion folds over inside the image, or sends more than
-// half of the undistorted image outside the distorted one (implausible
+// a quarter of the undistorted image outside the distorted one (implausible
 // parameters such as OPENCV k1 = 5), are refused, naming the camera and the
 // parameter.
 
@@ -41,7 +41,7 @@ Camera UndistortedCamera(const Camera& camera);
 // image the position of its sample in the distorted image (cv::remap puts
 // pixel centres at integers; COLMAP at +0.5, converted here). Throws
 // InputError naming the camera and its distortion parameters if more than
-// half of the pixels sample outside the distorted image, or the mapping is
+// a quarter of the pixels sample outside the distorted image, or the mapping is
 // not finite or folds over.
 void ComputeUndistortionMaps(const Camera& camera, cv::Mat* map_x, cv::Mat* map_y);
 
