@@ -395,7 +395,7 @@ TEST_F(MeshRefinerCli, TooFewFacesAreRefused) {
   triangle.F << 0, 1, 2;
   WritePly(dir_ + "/meshed-poisson.ply", triangle);
   ExpectRefused(RunCommand(kRefiner + " --workspace_path " + dir_ + kFast),
-                "the mesh has 1 faces; at least 20", dir_ + "/meshed-refined.ply", "sentinel");
+                "the mesh has 1 face; at least 20", dir_ + "/meshed-refined.ply", "sentinel");
   TriangleMesh cube;
   cube.V.resize(8, 3);
   cube.V << -1, -1, -1, 1, -1, -1, 1, 1, -1, -1, 1, -1, -1, -1, 1, 1, -1, 1, 1, 1, 1, -1, 1, 1;

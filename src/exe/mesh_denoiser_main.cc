@@ -50,6 +50,9 @@ int Run(int argc, char** argv) {
   TriangleMesh mesh = ReadMesh(input_path);
   MR_LOG(INFO) << "Read " << input_path << ": " << mesh.NumVertices() << " vertices, "
                << mesh.NumFaces() << " faces";
+  if (mesh.NumFaces() == 0) {
+    MR_THROW_INPUT << input_path << ": the mesh has no faces (a point cloud cannot be denoised)";
+  }
   const DenoiseResult result = Denoise(mesh.V, mesh.F, denoise);
   for (size_t k = 0; k < result.iterations.size(); ++k) {
     const DenoiseIteration& it = result.iterations[k];

@@ -52,6 +52,7 @@ int main(int argc, char** argv) {
     if (!manager.Parse(argc, argv)) return 0;
     options.Check();
     for (const std::string& path : {input_path, gt_path}) {
+      if (mr::ExistsDir(path)) MR_THROW_INPUT << path << ": is a folder; expected a mesh file";
       if (!mr::ExistsFile(path)) MR_THROW_INPUT << path << ": file does not exist";
     }
     const mr::TriangleMesh mesh = mr::ReadMesh(input_path);

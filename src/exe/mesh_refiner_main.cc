@@ -106,6 +106,12 @@ int Run(int argc, char** argv) {
   if (!options.Parse(argc, argv)) return 0;
   if (verbose) SetLogLevel(LogLevel::kVerbose);
   refine.Check();
+  // Before the output checks, which would otherwise blame the default output.
+  if (!ExistsDir(workspace_path)) {
+    MR_THROW_INPUT << workspace_path
+                   << (ExistsFile(workspace_path) ? ": is a file; expected a workspace folder"
+                                                  : ": workspace folder does not exist");
+  }
   if (output_path.empty()) output_path = JoinPaths(workspace_path, "meshed-refined.ply");
   RefuseOutputOverInput("--output_path", output_path, input_paths());
   const std::string output_ext = GetExtension(output_path);
@@ -128,6 +134,7 @@ int Run(int argc, char** argv) {
     }
   }
   RefuseOutputOverInput("--output_path", output_path, {input_path});
+  if (ExistsDir(input_path)) MR_THROW_INPUT << input_path << ": is a folder; expected a PLY mesh";
 
   const std::set<std::string> holdout =
       holdout_path.empty() ? std::set<std::string>{} : [&] {
@@ -144,7 +151,8 @@ int Run(int argc, char** argv) {
   }
   if (mesh.NumFaces() < kMinInputFaces) {
     MR_THROW_INPUT << input_path << ": the mesh has " << mesh.NumFaces()
-                   << " faces; at least " << kMinInputFaces
+                   << (mesh.NumFaces() == 1 ? " face" : " faces") << "; at least "
+                   << kMinInputFaces
                    << " are needed for a refinement to mean anything (is it the right file?)";
   }
   if (dry_run) {
