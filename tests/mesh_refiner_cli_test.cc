@@ -360,12 +360,16 @@ TEST_F(MeshRefinerCli, SigtermDuringTheWriteRemovesTheTemporary) {
   ASSERT_GE(reader, 0);
   ::fcntl(reader, F_SETPIPE_SZ, 4096);
   // Readable: the writer has opened the temporary and written into it.
+  // (Polled with a deadline and a sleep: a FIFO without a writer may report
+  // POLLHUP at once, which is not data.)
   struct pollfd poll_fd = {reader, POLLIN, 0};
   bool writing = false;
-  for (int waited_ms = 0; waited_ms < 300000 && !writing; waited_ms += 100) {
+  const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(300);
+  while (!writing && std::chrono::steady_clock::now() < deadline) {
     writing = ::poll(&poll_fd, 1, 100) > 0 && (poll_fd.revents & POLLIN);
     int status = 0;
     if (!writing && ::waitpid(pid, &status, WNOHANG) == pid) break;
+    if (!writing) std::this_thread::sleep_for(std::chrono::milliseconds(20));
   }
   if (!writing) ::kill(pid, SIGKILL);
   ASSERT_TRUE(writing) << ReadFileToString(log);
