@@ -450,15 +450,40 @@ void PrintTo(const BadInput& row, std::ostream* out) { *out << row.program << ":
 
 class BadInputTable : public ::testing::TestWithParam<BadInput> {
  protected:
-  // The base folder, made once: a workspace of 8 rendered views of a bumpy
-  // sphere with a PINHOLE model and a smooth sphere as the mesh; two meshes
-  // beside it; the existing outputs.
+  // The base folder: a workspace of 8 rendered views of a bumpy sphere with
+  // a PINHOLE model and a smooth sphere as the mesh; two meshes beside it;
+  // the existing outputs. CTest runs every row in its own process, so it is
+  // made once per build of this test (named after the executable's time
+  // stamp) and kept in the temporary folder; folders of earlier builds are
+  // removed.
   static void SetUpTestSuite() {
-    base_ = (fs::temp_directory_path() / "mr_bad_input_base").string();
-    fs::remove_all(base_);
-    fs::create_directories(base_ + "/ws/images");
-    fs::create_directories(base_ + "/ws/sparse");
-    fs::create_directories(base_ + "/sub");
+    std::error_code ec;
+    const auto stamp = fs::last_write_time("/proc/self/exe", ec).time_since_epoch().count();
+    const fs::path tmp = fs::temp_directory_path();
+    const std::string prefix = "mr_bad_input_base_";
+    base_ = (tmp / (prefix + std::to_string(stamp))).string();
+    if (ExistsFile(base_ + "/complete")) return;
+    for (const auto& entry : fs::directory_iterator(tmp, ec)) {
+      const std::string name = entry.path().filename().string();
+      if (name.rfind(prefix, 0) == 0 && entry.path().string() != base_) {
+        fs::remove_all(entry.path(), ec);
+      }
+    }
+    // Built beside, then renamed into place: parallel test processes either
+    // find it complete or build their own.
+    const std::string building = base_ + "_building_" + std::to_string(::getpid());
+    fs::remove_all(building);
+    BuildBase(building);
+    WriteText(building + "/complete", "");
+    fs::rename(building, base_, ec);
+    if (ec) fs::remove_all(building);  // another process was first
+    ASSERT_TRUE(ExistsFile(base_ + "/complete"));
+  }
+
+  static void BuildBase(const std::string& base) {
+    fs::create_directories(base + "/ws/images");
+    fs::create_directories(base + "/ws/sparse");
+    fs::create_directories(base + "/sub");
     Renderer renderer;
     Eigen::MatrixXd V;
     Eigen::MatrixXi F;
@@ -483,16 +508,15 @@ class BadInputTable : public ::testing::TestWithParam<BadInput> {
       model.images[image.image_id] = image;
       cv::Mat u8;
       source.LoadGray(i).convertTo(u8, CV_8U, 255.0);
-      cv::imwrite(base_ + "/ws/images/" + image.name, u8);
+      cv::imwrite(base + "/ws/images/" + image.name, u8);
     }
-    WriteSparseModelBinary(base_ + "/ws/sparse", model);
-    WritePly(base_ + "/ws/meshed-poisson.ply", Sphere(3, 1.0));
-    WriteText(base_ + "/ws/meshed-refined.ply", kExistingOutput);
-    WritePly(base_ + "/m.ply", Sphere(2, 1.0));
-    WritePly(base_ + "/gt.ply", Sphere(3, 1.01));
-    WriteText(base_ + "/out.ply", kExistingOutput);
+    WriteSparseModelBinary(base + "/ws/sparse", model);
+    WritePly(base + "/ws/meshed-poisson.ply", Sphere(3, 1.0));
+    WriteText(base + "/ws/meshed-refined.ply", kExistingOutput);
+    WritePly(base + "/m.ply", Sphere(2, 1.0));
+    WritePly(base + "/gt.ply", Sphere(3, 1.01));
+    WriteText(base + "/out.ply", kExistingOutput);
   }
-  static void TearDownTestSuite() { fs::remove_all(base_); }
 
   static std::string base_;
 };
@@ -503,6 +527,7 @@ TEST_P(BadInputTable, RefusedAndNothingChanged) {
   const std::string dir = (fs::temp_directory_path() / ("mr_bad_input_" + row.name)).string();
   fs::remove_all(dir);
   fs::copy(base_, dir, fs::copy_options::recursive);
+  fs::remove(dir + "/complete");
   row.prepare(dir);
   const std::map<std::string, std::string> before = Snapshot(dir);
 
