@@ -26,6 +26,7 @@
 #include "refine/test_scene.h"
 #include "render/renderer.h"
 #include "tests/command.h"
+#include "tests/test_workspace.h"
 #include "util/file.h"
 
 namespace mr {
@@ -481,36 +482,8 @@ class BadInputTable : public ::testing::TestWithParam<BadInput> {
   }
 
   static void BuildBase(const std::string& base) {
-    fs::create_directories(base + "/ws/images");
-    fs::create_directories(base + "/ws/sparse");
     fs::create_directories(base + "/sub");
-    Renderer renderer;
-    Eigen::MatrixXd V;
-    Eigen::MatrixXi F;
-    MakeBumpySphere(4, 0.06, &V, &F);
-    const InMemoryViewSource source = MakeTestScene(V, F, {}, {}, &renderer);
-    Reconstruction model;
-    for (int i = 0; i < source.NumViews(); ++i) {
-      const PinholeView& view = source.View(i);
-      Camera camera;
-      camera.camera_id = i + 1;
-      camera.model = CameraModel::kPinhole;
-      camera.width = view.width;
-      camera.height = view.height;
-      camera.params = {view.fx, view.fy, view.cx, view.cy};
-      model.cameras[camera.camera_id] = camera;
-      Image image;
-      image.image_id = i + 1;
-      image.camera_id = camera.camera_id;
-      image.name = source.Name(i) + ".png";
-      image.qvec = RotationToQuaternion(view.R);
-      image.tvec = view.t;
-      model.images[image.image_id] = image;
-      cv::Mat u8;
-      source.LoadGray(i).convertTo(u8, CV_8U, 255.0);
-      cv::imwrite(base + "/ws/images/" + image.name, u8);
-    }
-    WriteSparseModelBinary(base + "/ws/sparse", model);
+    WriteRenderedTestWorkspace(base + "/ws");
     WritePly(base + "/ws/meshed-poisson.ply", Sphere(3, 1.0));
     WriteText(base + "/ws/meshed-refined.ply", kExistingOutput);
     WritePly(base + "/m.ply", Sphere(2, 1.0));

@@ -22,6 +22,7 @@
 #include "refine/test_scene.h"
 #include "render/renderer.h"
 #include "tests/command.h"
+#include "tests/test_workspace.h"
 #include "util/file.h"
 
 namespace mr {
@@ -40,35 +41,7 @@ class MeshRefinerCli : public ::testing::Test {
     dir_ = fs::temp_directory_path() /
            ("mr_cli_ws_" + std::string(::testing::UnitTest::GetInstance()->current_test_info()->name()));
     fs::remove_all(dir_);
-    fs::create_directories(dir_ + "/images");
-    fs::create_directories(dir_ + "/sparse");
-    Renderer renderer;
-    Eigen::MatrixXd V;
-    Eigen::MatrixXi F;
-    MakeBumpySphere(4, 0.06, &V, &F);
-    const InMemoryViewSource source = MakeTestScene(V, F, {}, {}, &renderer);
-    Reconstruction model;
-    for (int i = 0; i < source.NumViews(); ++i) {
-      const PinholeView& view = source.View(i);
-      Camera camera;
-      camera.camera_id = i + 1;
-      camera.model = CameraModel::kPinhole;
-      camera.width = view.width;
-      camera.height = view.height;
-      camera.params = {view.fx, view.fy, view.cx, view.cy};
-      model.cameras[camera.camera_id] = camera;
-      Image image;
-      image.image_id = i + 1;
-      image.camera_id = camera.camera_id;
-      image.name = source.Name(i) + ".png";
-      image.qvec = RotationToQuaternion(view.R);
-      image.tvec = view.t;
-      model.images[image.image_id] = image;
-      cv::Mat u8;
-      source.LoadGray(i).convertTo(u8, CV_8U, 255.0);
-      cv::imwrite(dir_ + "/images/" + image.name, u8);
-    }
-    WriteSparseModelBinary(dir_ + "/sparse", model);
+    WriteRenderedTestWorkspace(dir_);
     TriangleMesh initial;
     MakeIcosphere(3, 1.0, &initial.V, &initial.F);
     WritePly(dir_ + "/meshed-poisson.ply", initial);
