@@ -5,6 +5,7 @@
 #   bash scripts/fuzz.sh                      # every harness for 30 s
 #   bash scripts/fuzz.sh --time 600 ply obj   # these two for 10 minutes each
 #   bash scripts/fuzz.sh --runs 10000000      # every harness for 10M executions
+#   bash scripts/fuzz.sh --runs 10000000 --time 900   # whichever comes first
 #   bash scripts/fuzz.sh --strict ...         # exceptions other than mr::InputError are findings
 #   bash scripts/fuzz.sh --build-only
 #
@@ -30,22 +31,23 @@ declare -A MAX_LEN=(
 ALL=(ply obj dense_array fused_vis ini image cameras_bin images_bin points3D_bin
      cameras_txt images_txt points3D_txt)
 
-limit=(-max_total_time=30)
+limit=()
 build_only=0
 harnesses=()
 while [ $# -gt 0 ]; do
   case "$1" in
-    --time) limit=(-max_total_time="$2"); shift 2 ;;
-    --runs) limit=(-runs="$2"); shift 2 ;;
+    --time) limit+=(-max_total_time="$2"); shift 2 ;;
+    --runs) limit+=(-runs="$2"); shift 2 ;;
     --strict) export MR_FUZZ_STRICT=1; shift ;;
     --build-only) build_only=1; shift ;;
-    -h|--help) sed -n '2,18p' "$0"; exit 0 ;;
+    -h|--help) sed -n '2,19p' "$0"; exit 0 ;;
     -*) echo "fuzz.sh: unknown option $1" >&2; exit 2 ;;
     *) [ -n "${MAX_LEN[$1]:-}" ] || { echo "fuzz.sh: unknown harness $1 (${ALL[*]})" >&2; exit 2; }
        harnesses+=("$1"); shift ;;
   esac
 done
 [ ${#harnesses[@]} -gt 0 ] || harnesses=("${ALL[@]}")
+[ ${#limit[@]} -gt 0 ] || limit=(-max_total_time=30)
 
 CXX_CLANG=${CXX_CLANG:-clang++}
 command -v "$CXX_CLANG" >/dev/null || { echo "fuzz.sh: $CXX_CLANG not found (scripts/install_deps.sh)" >&2; exit 2; }
