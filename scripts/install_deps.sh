@@ -1,5 +1,6 @@
 #!/usr/bin/env bash
 # Installs the Debian 12 packages mesh_refiner needs, only if some are missing.
+# clang, its sanitizer and libFuzzer runtimes and llvm-symbolizer: scripts/fuzz.sh, sanitize.sh.
 set -euo pipefail
 PACKAGES=(
   build-essential cmake pkg-config
@@ -7,6 +8,7 @@ PACKAGES=(
   libopencv-dev libgtest-dev libtbb-dev
   libegl-dev libgl-dev libgles-dev libegl-mesa0 libgl1-mesa-dri
   colmap
+  clang libclang-rt-14-dev llvm
 )
 missing=()
 for p in "${PACKAGES[@]}"; do
