@@ -10,16 +10,34 @@
 // must contain its IEND chunk. Data after a complete image (zero padding,
 // trailers some cameras append) is allowed.
 
+#include <cstdint>
 #include <string>
 
 #include <opencv2/core.hpp>
 
 namespace mr {
 
-// Throws InputError "<path>: truncated or corrupt image (...)" if `data`, the
-// bytes of the file at `path`, is a JPEG or PNG that ends before its image
-// does. Other formats are left to the decoder.
-void CheckImageComplete(const std::string& path, const std::string& data);
+// The formats read are JPEG, PNG, TIFF, BMP and PNM (P1-P6); their headers
+// are read here, before OpenCV decodes, so that a corrupt header cannot make
+// the decoder allocate gigabytes. At most kMaxImagePixels pixels and
+// kMaxDecodedImageBytes decoded bytes per image (the largest camera sensors
+// give about 150 megapixels, 900 MiB as 16-bit RGB).
+constexpr int64_t kMaxImagePixels = int64_t(1) << 28;        // 268 megapixels
+constexpr int64_t kMaxDecodedImageBytes = int64_t(1) << 30;  // 1 GiB
+
+struct ImageHeader {
+  const char* format = "";  // "JPEG", "PNG", "TIFF", "BMP", "PNM"
+  int64_t width = 0;
+  int64_t height = 0;
+  int channels = 0;          // as OpenCV decodes with IMREAD_UNCHANGED (at most)
+  int bytes_per_sample = 0;  // likewise
+};
+
+// The header of the image file at `path` whose bytes are `data`. Throws
+// InputError naming `path` for another format, a size of zero or over
+// kMaxImagePixels, and "truncated or corrupt image (...)" for a JPEG or PNG
+// that ends before its image does.
+ImageHeader ReadImageHeader(const std::string& path, const std::string& data);
 
 // Reads an image file with cv::imread flags (cv::IMREAD_COLOR, _GRAYSCALE,
 // _UNCHANGED; cv::IMREAD_IGNORE_ORIENTATION is added). `what` names the file
@@ -28,7 +46,8 @@ void CheckImageComplete(const std::string& path, const std::string& data);
 cv::Mat ReadImageFile(const std::string& path, int flags, const std::string& what = "image");
 
 // ReadImageFile after the file was read: checks and decodes its bytes `data`
-// (empty, too large, truncated, undecodable: InputError naming `path`).
+// (empty, another format, too large, truncated, undecodable: InputError
+// naming `path`).
 cv::Mat DecodeImageFile(const std::string& path, const std::string& data, int flags,
                         const std::string& what = "image");
 

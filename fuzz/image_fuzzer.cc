@@ -1,5 +1,5 @@
-// Workspace images and masks (colmap_io/image_file.h): the completeness check
-// for JPEG and PNG, then OpenCV's decoders. The read flag follows the input's
+// Workspace images and masks (colmap_io/image_file.h): the header reader
+// (format, size limits, JPEG and PNG completeness), then OpenCV's decoders. The read flag follows the input's
 // size modulo 3 (colour as for images, greyscale as for masks, unchanged as
 // for undistortion), so every input picks one and trailing bytes, which a
 // complete JPEG or PNG may carry, switch between them.

@@ -31,7 +31,7 @@ cmake -S . -B "$BUILD" -DCMAKE_BUILD_TYPE=RelWithDebInfo \
 
 READER_TESTS=(colmap_io_camera_models_test colmap_io_sparse_model_test colmap_io_dense_array_test
               colmap_io_undistortion_test colmap_io_workspace_test colmap_io_ply_test
-              colmap_io_mesh_io_test util_test)
+              colmap_io_mesh_io_test colmap_io_image_file_test util_test)
 CLI_TESTS=(mesh_refiner_cli_test mesh_programs_cli_test)
 if grep -q "bad_input_table_test" tests/CMakeLists.txt 2>/dev/null; then
   CLI_TESTS+=(bad_input_table_test)

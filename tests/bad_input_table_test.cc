@@ -202,7 +202,18 @@ std::vector<BadInput> Table() {
        kWs + kFast, 1, "view_2.jpg: truncated or corrupt image"},
       {"RefinerImageNotAnImage", R, "an image file that holds text",
        [](const std::string& d) { WriteText(d + "/ws/images/view_2.png", "not an image\n"); },
-       kWs + kFast, 1, "view_2.png: cannot decode the image"},
+       kWs + kFast, 1, "view_2.png: not a JPEG, PNG, TIFF, BMP or PNM image"},
+      {"RefinerImageInAnotherFormat", R, "a WebP image (a format OpenCV reads but we do not)",
+       [](const std::string& d) {
+         WriteText(d + "/ws/images/view_2.png", std::string("RIFF\x24\0\0\0WEBPVP8 ", 16));
+       },
+       kWs + kFast, 1, "view_2.png: not a JPEG, PNG, TIFF, BMP or PNM image"},
+      {"RefinerImageHeaderOfAGigapixel", R,
+       "a PNM image whose header claims 40000 x 40000 pixels (the decoder would allocate 4.8 GB)",
+       [](const std::string& d) {
+         WriteText(d + "/ws/images/view_2.png", "P6\n40000 40000\n255\n" + std::string(64, 'x'));
+       },
+       kWs + kFast, 1, "view_2.png: PNM header gives 40000 x 40000 pixels"},
       {"RefinerMasksMatchingNoImage", R,
        "`masks/` whose files match no image (`view_0.png`, not COLMAP's `view_0.png.png`)",
        [](const std::string& d) {

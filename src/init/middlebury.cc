@@ -385,13 +385,9 @@ MiddleburyConversionSummary ConvertMiddlebury(const std::string& input_path,
     const std::string src = JoinPaths(input_path, mb.name);
     if (!ExistsFile(src)) MR_THROW_INPUT << par_path << ": image " << mb.name << " is missing";
     const std::string bytes = ReadFileToString(src);
-    const cv::Mat raw(1, static_cast<int>(bytes.size()), CV_8U,
-                      const_cast<char*>(bytes.data()));
     // The bytes are copied as they are: the camera must match the raw pixels
     // (EXIF orientation ignored, as COLMAP and our workspace reader do).
-    CheckImageComplete(src, bytes);
-    const cv::Mat image = cv::imdecode(raw, cv::IMREAD_COLOR | cv::IMREAD_IGNORE_ORIENTATION);
-    if (image.empty()) MR_THROW_INPUT << src << ": cannot decode the image";
+    const cv::Mat image = DecodeImageFile(src, bytes, cv::IMREAD_COLOR);
     const uint32_t id = static_cast<uint32_t>(i + 1);
     Camera camera;
     Image img;

@@ -1,0 +1,154 @@
+#include "colmap_io/image_file.h"
+
+#include <string>
+#include <vector>
+
+#include <gtest/gtest.h>
+#include <opencv2/imgcodecs.hpp>
+
+#include "util/error.h"
+
+namespace mr {
+namespace {
+
+std::string Encode(const std::string& ext, const cv::Mat& image) {
+  std::vector<uchar> bytes;
+  EXPECT_TRUE(cv::imencode(ext, image, bytes)) << ext;
+  return std::string(bytes.begin(), bytes.end());
+}
+
+// The InputError message of `f`, or "" if it did not throw.
+template <typename F>
+std::string ErrorOf(F f) {
+  try {
+    f();
+  } catch (const InputError& e) {
+    return e.what();
+  }
+  return "";
+}
+
+cv::Mat Pattern(int rows, int cols, int type) {
+  cv::Mat image(rows, cols, type);
+  cv::randu(image, 0, CV_MAT_DEPTH(type) == CV_16U ? 65535 : 255);
+  return image;
+}
+
+// The header gives the size, channels and depth that OpenCV then decodes.
+TEST(ImageFile, HeaderMatchesTheDecodedImage) {
+  struct Case {
+    std::string ext;
+    int type;
+  };
+  const std::vector<Case> cases = {
+      {".jpg", CV_8UC1},  {".jpg", CV_8UC3},  {".png", CV_8UC1},  {".png", CV_8UC3},
+      {".png", CV_8UC4},  {".png", CV_16UC1}, {".png", CV_16UC3}, {".tif", CV_8UC1},
+      {".tif", CV_8UC3},  {".tif", CV_16UC3}, {".bmp", CV_8UC3},  {".bmp", CV_8UC4},
+      {".pgm", CV_8UC1},  {".ppm", CV_8UC3},  {".pgm", CV_16UC1}, {".ppm", CV_16UC3}};
+  for (const Case& c : cases) {
+    SCOPED_TRACE(c.ext + " type " + std::to_string(c.type));
+    const std::string data = Encode(c.ext, Pattern(37, 53, c.type));
+    const ImageHeader header = ReadImageHeader("x" + c.ext, data);
+    const cv::Mat decoded = DecodeImageFile("x" + c.ext, data, cv::IMREAD_UNCHANGED);
+    EXPECT_EQ(header.width, 53);
+    EXPECT_EQ(header.height, 37);
+    EXPECT_EQ(decoded.cols, 53);
+    EXPECT_EQ(decoded.rows, 37);
+    // The header may overstate (a BMP's channels), never understate.
+    EXPECT_GE(header.channels, decoded.channels());
+    EXPECT_EQ(header.bytes_per_sample, static_cast<int>(decoded.elemSize1()));
+    EXPECT_EQ(DecodeImageFile("x" + c.ext, data, cv::IMREAD_COLOR).type(), CV_8UC3);
+    EXPECT_EQ(DecodeImageFile("x" + c.ext, data, cv::IMREAD_GRAYSCALE).type(), CV_8UC1);
+  }
+}
+
+// A few bytes of header that claim a huge image are refused before OpenCV
+// allocates it (the fuzz finding: a 3 GB allocation from a 200-byte file).
+TEST(ImageFile, HugeHeadersAreRefusedBeforeDecoding) {
+  const std::string pnm = "P6\n# comment\n40000 40000\n255\n" + std::string(64, 'x');
+  EXPECT_NE(ErrorOf([&] { DecodeImageFile("a.ppm", pnm, cv::IMREAD_COLOR); })
+                .find("a.ppm: PNM header gives 40000 x 40000 pixels (1600 megapixels), more "
+                      "than the 268 megapixels read"),
+            std::string::npos);
+
+  std::string png = Encode(".png", Pattern(8, 8, CV_8UC3));
+  // IHDR: big-endian width at byte 16, height at 20; 65535 x 65535.
+  png.replace(16, 8, std::string("\0\0\xff\xff\0\0\xff\xff", 8));
+  EXPECT_NE(ErrorOf([&] { DecodeImageFile("b.png", png, cv::IMREAD_COLOR); })
+                .find("b.png: PNG header gives 65535 x 65535 pixels"),
+            std::string::npos);
+
+  // A JPEG's start-of-frame segment: FF C0, length, precision, height, width.
+  std::string jpg = Encode(".jpg", Pattern(8, 8, CV_8UC3));
+  const size_t sof = jpg.find("\xff\xc0");
+  ASSERT_NE(sof, std::string::npos);
+  jpg[sof + 5] = jpg[sof + 6] = jpg[sof + 7] = jpg[sof + 8] = char(0xff);
+  EXPECT_NE(ErrorOf([&] { DecodeImageFile("c.jpg", jpg, cv::IMREAD_GRAYSCALE); })
+                .find("c.jpg: JPEG header gives 65535 x 65535 pixels"),
+            std::string::npos);
+
+  std::string bmp = Encode(".bmp", Pattern(8, 8, CV_8UC3));
+  bmp.replace(18, 4, std::string("\0\0\0\x10", 4));  // little-endian width 0x10000000
+  EXPECT_NE(ErrorOf([&] { DecodeImageFile("d.bmp", bmp, cv::IMREAD_COLOR); })
+                .find("d.bmp: BMP header gives 268435456 x 8 pixels"),
+            std::string::npos);
+
+  EXPECT_NE(ErrorOf([&] { DecodeImageFile("e.pgm", "P5 0 7 255\n", cv::IMREAD_COLOR); })
+                .find("e.pgm: PNM header gives a size of 0 x 7 pixels (corrupt)"),
+            std::string::npos);
+}
+
+// Within the pixel limit, the decoded bytes are limited too: 16384 x 16384
+// pixels as 16-bit RGBA would take 2 GiB.
+TEST(ImageFile, DecodedSizeIsLimitedForTheFlagsAsked) {
+  std::string png = Encode(".png", Pattern(8, 8, CV_16UC4));
+  png.replace(16, 8, std::string("\0\0\x40\0\0\0\x40\0", 8));  // 16384 x 16384
+  const ImageHeader header = ReadImageHeader("f.png", png);
+  EXPECT_EQ(header.width * header.height, kMaxImagePixels);
+  EXPECT_EQ(header.channels * header.bytes_per_sample, 8);
+  EXPECT_NE(ErrorOf([&] { DecodeImageFile("f.png", png, cv::IMREAD_UNCHANGED, "mask"); })
+                .find("f.png: PNG of 16384 x 16384 pixels would take 2048 MiB decoded, more "
+                      "than the 1024 MiB read per mask"),
+            std::string::npos);
+}
+
+TEST(ImageFile, OtherFormatsAndNonImagesAreRefused) {
+  const std::string kWhy = ": not a JPEG, PNG, TIFF, BMP or PNM image";
+  EXPECT_NE(ErrorOf([] { DecodeImageFile("t.png", "not an image\n", cv::IMREAD_COLOR); })
+                .find("t.png" + kWhy),
+            std::string::npos);
+  // Radiance HDR: OpenCV would decode it (through a temporary file).
+  EXPECT_NE(ErrorOf([] {
+              DecodeImageFile("h.hdr", "#?RADIANCE\nFORMAT=32-bit_rle_rgbe\n\n-Y 9 +X 9\n",
+                              cv::IMREAD_COLOR);
+            }).find("h.hdr" + kWhy),
+            std::string::npos);
+  EXPECT_NE(ErrorOf([] { DecodeImageFile("e.png", "", cv::IMREAD_COLOR); })
+                .find("e.png: image file is empty"),
+            std::string::npos);
+}
+
+// Cut files: the JPEG and PNG completeness checks name what is missing.
+TEST(ImageFile, TruncatedHeadersAreCorrupt) {
+  const std::string png = Encode(".png", Pattern(8, 8, CV_8UC3));
+  for (size_t keep : {size_t(9), size_t(20), size_t(40)}) {
+    EXPECT_NE(ErrorOf([&] { ReadImageHeader("p.png", png.substr(0, keep)); })
+                  .find("p.png: truncated or corrupt image"),
+              std::string::npos)
+        << keep;
+  }
+  const std::string jpg = Encode(".jpg", Pattern(8, 8, CV_8UC3));
+  for (size_t keep : {size_t(3), size_t(10), jpg.size() - 2}) {
+    EXPECT_NE(ErrorOf([&] { ReadImageHeader("j.jpg", jpg.substr(0, keep)); })
+                  .find("j.jpg: truncated or corrupt image"),
+              std::string::npos)
+        << keep;
+  }
+  const std::string tif = Encode(".tif", Pattern(8, 8, CV_8UC3));
+  EXPECT_NE(ErrorOf([&] { ReadImageHeader("t.tif", tif.substr(0, 6)); })
+                .find("t.tif: truncated or corrupt image (TIFF ends inside its header)"),
+            std::string::npos);
+}
+
+}  // namespace
+}  // namespace mr
