@@ -61,6 +61,7 @@ TEST_F(MeshRefinerCli, Nominal) {
   const CommandResult r = RunCommand(kRefiner + " --workspace_path " + dir_ + kFast);
   ASSERT_EQ(r.exit_code, 0) << r.output;
   EXPECT_EQ(r.output.find("probably meaningless"), std::string::npos) << r.output;
+  EXPECT_EQ(r.output.find("covers only"), std::string::npos) << r.output;
   const TriangleMesh out = ReadPly(dir_ + "/meshed-refined.ply");
   EXPECT_GT(out.NumFaces(), 100);
   EXPECT_EQ(out.C.rows(), out.NumVertices()) << "vertex colours expected";
@@ -420,6 +421,19 @@ TEST_F(MeshRefinerCli, MeaninglessResultIsFlagged) {
   ASSERT_EQ(r.exit_code, 0) << r.output;
   EXPECT_NE(r.output.find("WARNING: the final mean similarity is"), std::string::npos) << r.output;
   EXPECT_NE(r.output.find("probably meaningless"), std::string::npos) << r.output;
+}
+
+// A mesh a tenth of the object's size (a mesh of another scale, say) covers
+// a few dozen pixels: a WARNING names the file and the coverage before the
+// refinement starts.
+TEST_F(MeshRefinerCli, MeshCoveringFewPixelsIsFlagged) {
+  TriangleMesh tiny;
+  MakeIcosphere(3, 0.1, &tiny.V, &tiny.F);
+  WritePly(dir_ + "/meshed-poisson.ply", tiny);
+  const CommandResult r = RunCommand(kRefiner + " --workspace_path " + dir_ + kFast);
+  EXPECT_NE(r.output.find("WARNING: " + dir_ + "/meshed-poisson.ply covers only"), std::string::npos)
+      << r.output;
+  EXPECT_NE(r.output.find("(expected at least 1 %)"), std::string::npos) << r.output;
 }
 
 TEST_F(MeshRefinerCli, BadOptionNamesTheField) {

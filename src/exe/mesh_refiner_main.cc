@@ -39,6 +39,12 @@ constexpr int kMinInputFaces = 20;
 // another scene or a collapsed mesh score about 0.
 constexpr double kMeaninglessSimilarity = 0.05;
 
+// A mesh that covers less than this fraction of every image is refined from
+// a few hundred pixels at best (1 % of a 640x480 image is a disc 62 pixels
+// across): the refinement can do little, and the mesh is often the wrong
+// one or the cameras' scale is off.
+constexpr double kMinImageCoverage = 0.01;
+
 void WarnIfMeaningless(const RefineSummary& summary) {
   if (summary.final_similarity > kMeaninglessSimilarity) return;
   MR_LOG(WARNING) << "WARNING: the final mean similarity is " << summary.final_similarity
@@ -163,6 +169,14 @@ int Run(int argc, char** argv) {
     MR_THROW_INPUT << input_path
                    << ": the mesh is not visible in any view: no vertex faces a camera inside its "
                       "image (is the mesh in the same coordinate frame as the sparse model?)";
+  }
+  const double coverage = BestViewCoverage(source.Views(), mesh.V, mesh.F);
+  if (coverage < kMinImageCoverage) {
+    MR_LOG(WARNING) << "WARNING: " << input_path << " covers only " << 100 * coverage
+                    << " % of the image in the view that sees most of it (expected at least "
+                    << 100 * kMinImageCoverage
+                    << " %): too few pixels to refine from. Is it the mesh of these images, in "
+                       "the sparse model's frame and scale?";
   }
   if (refine.color == "principal") {
     const Eigen::Vector3d w = PrincipalTextureColor(source);

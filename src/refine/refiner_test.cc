@@ -272,6 +272,34 @@ TEST_F(RefinerTest, ViewsWithoutOverlapAreRefused) {
   EXPECT_THROW(RefineMesh(source, FastOptions(), &mesh, renderer_), InputError);
 }
 
+// A sphere of radius r seen from distance d projects to a disc of radius
+// f r / sqrt(d^2 - r^2) pixels; the faces that face the camera cover it once.
+TEST(BestViewCoverage, SphereCoversItsProjectedDisc) {
+  Eigen::MatrixXd V;
+  Eigen::MatrixXi F;
+  MakeIcosphere(4, 1.0, &V, &F);
+  const int w = 640, h = 480;
+  const double f = 300;
+  const auto view_at = [&](double d) {
+    return LookAtView(Eigen::Vector3d(0, -d, 0), Eigen::Vector3d::Zero(), Eigen::Vector3d::UnitZ(),
+                      w, h, f);
+  };
+  const auto disc = [&](double d) { return M_PI * f * f / (d * d - 1) / (w * h); };
+  EXPECT_NEAR(BestViewCoverage({view_at(4)}, V, F), disc(4), 0.02 * disc(4));
+  // The best of the views counts, not their sum.
+  EXPECT_NEAR(BestViewCoverage({view_at(40), view_at(4), view_at(8)}, V, F), disc(4),
+              0.02 * disc(4));
+  EXPECT_LT(BestViewCoverage({view_at(40)}, V, F), 0.001);
+  // Behind the camera, or wholly outside the image: nothing.
+  const PinholeView away = LookAtView(Eigen::Vector3d(0, -4, 0), Eigen::Vector3d(0, -8, 0),
+                                     Eigen::Vector3d::UnitZ(), w, h, f);
+  EXPECT_EQ(BestViewCoverage({away}, V, F), 0.0);
+  const Eigen::MatrixXd aside = V.rowwise() + Eigen::RowVector3d(30, 0, 0);
+  EXPECT_EQ(BestViewCoverage({view_at(4)}, aside, F), 0.0);
+  // Filling the whole image is capped at 1.
+  EXPECT_EQ(BestViewCoverage({view_at(1.05)}, V, F), 1.0);
+}
+
 TEST(RefineOptions, DefaultsAreValid) { EXPECT_TRUE(RefineOptions().Check()); }
 
 TEST(RefineOptions, BadValuesNameTheField) {

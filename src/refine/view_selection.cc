@@ -4,6 +4,8 @@
 #include <cmath>
 #include <set>
 
+#include <Eigen/Geometry>
+
 #include "geometry/mesh.h"
 #include "util/error.h"
 
@@ -118,6 +120,34 @@ double MedianFootprint(const std::vector<PinholeView>& views, const Eigen::Matri
   std::nth_element(footprints.begin(), footprints.begin() + footprints.size() / 2,
                    footprints.end());
   return footprints[footprints.size() / 2];
+}
+
+double BestViewCoverage(const std::vector<PinholeView>& views, const Eigen::MatrixXd& V,
+                        const Eigen::MatrixXi& F) {
+  double best = 0;
+  for (const PinholeView& view : views) {
+    double area = 0;
+    const Eigen::Vector3d center = view.Center();
+    for (int f = 0; f < F.rows(); ++f) {
+      const Eigen::Vector3d x0 = V.row(F(f, 0)), x1 = V.row(F(f, 1)), x2 = V.row(F(f, 2));
+      if ((x1 - x0).cross(x2 - x0).dot(center - x0) <= 0) continue;  // faces away
+      Eigen::Vector2d p[3];
+      bool in_front = true;
+      for (int k = 0; k < 3; ++k) {
+        const Eigen::Vector3d xc = view.WorldToCamera(V.row(F(f, k)).transpose());
+        in_front = in_front && xc.z() > 0;
+        p[k] = view.CameraToImage(xc);
+      }
+      if (!in_front) continue;
+      const Eigen::Vector2d lo = p[0].cwiseMin(p[1]).cwiseMin(p[2]);
+      const Eigen::Vector2d hi = p[0].cwiseMax(p[1]).cwiseMax(p[2]);
+      if (hi.x() < 0 || hi.y() < 0 || lo.x() > view.width || lo.y() > view.height) continue;
+      const Eigen::Vector2d a = p[1] - p[0], b = p[2] - p[0];
+      area += 0.5 * std::abs(a.x() * b.y() - a.y() * b.x());
+    }
+    best = std::max(best, std::min(1.0, area / (double(view.width) * view.height)));
+  }
+  return best;
 }
 
 std::vector<std::pair<int, int>> NeighborPairs(const std::vector<std::vector<int>>& neighbors) {

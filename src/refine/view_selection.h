@@ -43,6 +43,14 @@ std::vector<std::pair<int, int>> NeighborPairs(const std::vector<std::vector<int
 double MedianFootprint(const std::vector<PinholeView>& views, const Eigen::MatrixXd& V,
                        const Eigen::MatrixXd& N);
 
+// The largest fraction of an image that the mesh (V, F) covers, over the
+// views: the projected area of the faces in front of the camera, facing it
+// and not wholly outside the image, over the image area, capped at 1.
+// Occlusion is not resolved (the faces of a closed surface that face a
+// camera cover its outline about once). 0 if no view sees a face.
+double BestViewCoverage(const std::vector<PinholeView>& views, const Eigen::MatrixXd& V,
+                        const Eigen::MatrixXi& F);
+
 // Faces of an isotropic mesh of the surface (V, F) with edges of `edge_px`
 // median pixel footprints in `views` (area / (sqrt(3)/4 e^2)), at most
 // `max_faces`: what remeshing for a pyramid level gives. 0 if no view sees
