@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cctype>
+#include <cmath>
 #include <cstdint>
 #include <cstdlib>
 #include <filesystem>
@@ -114,7 +115,7 @@ ImageHeader ReadTiffHeader(const std::string& path, const std::string& data) {
     const uint32_t value = type == 3 ? u16(entry + 8) : u32(entry + 8);
     if (tag == 256) header.width = value;
     if (tag == 257) header.height = value;
-    if (tag == 277) header.channels = std::max<uint32_t>(1, value);
+    if (tag == 277) header.channels = static_cast<int>(std::clamp<uint32_t>(value, 1, 65535));
     if (tag == 258) {
       uint64_t bits = value;
       if (type == 3 && n > 2) {  // more than fit in the field: it holds their offset
@@ -165,7 +166,7 @@ ImageHeader ReadPnmHeader(const std::string& path, const std::string& data) {
     }
     int64_t v = 0;
     while (pos < data.size() && std::isdigit(static_cast<unsigned char>(data[pos]))) {
-      v = std::min<int64_t>(v * 10 + (data[pos++] - '0'), int64_t(1) << 40);
+      v = std::min<int64_t>(v * 10 + (data[pos++] - '0'), int64_t(1) << 32);  // no overflow
     }
     return v;
   };
@@ -202,7 +203,9 @@ ImageHeader ReadImageHeader(const std::string& path, const std::string& data) {
                    << " x " << header.height << " pixels (corrupt)";
   }
   const double megapixels = 1e-6 * static_cast<double>(header.width) * static_cast<double>(header.height);
-  if (header.width * header.height > kMaxImagePixels) {
+  // Each size is checked alone first: a header's two 32-bit sizes can overflow a product.
+  if (header.width > kMaxImagePixels || header.height > kMaxImagePixels ||
+      header.width * header.height > kMaxImagePixels) {
     MR_THROW_INPUT << path << ": " << header.format << " header gives " << header.width << " x "
                    << header.height << " pixels (" << megapixels << " megapixels), more than the "
                    << kMaxImagePixels / 1000000 << " megapixels read (corrupt header, or split the image)";
@@ -234,10 +237,11 @@ cv::Mat DecodeImageFile(const std::string& path, const std::string& data, int fl
   const int64_t bytes_per_pixel = flags == cv::IMREAD_UNCHANGED
                                       ? int64_t(header.channels) * header.bytes_per_sample
                                       : (flags & cv::IMREAD_COLOR) ? 3 : 1;
-  const int64_t decoded = header.width * header.height * bytes_per_pixel;
-  if (decoded > kMaxDecodedImageBytes) {
+  // In floating point: a TIFF may claim 65535 samples of 8192 bytes.
+  const double decoded = static_cast<double>(header.width * header.height) * bytes_per_pixel;
+  if (decoded > static_cast<double>(kMaxDecodedImageBytes)) {
     MR_THROW_INPUT << path << ": " << header.format << " of " << header.width << " x "
-                   << header.height << " pixels would take " << decoded / (1 << 20)
+                   << header.height << " pixels would take " << std::llround(decoded / (1 << 20))
                    << " MiB decoded, more than the " << kMaxDecodedImageBytes / (1 << 20)
                    << " MiB read per " << what << " (corrupt header, or split the image)";
   }

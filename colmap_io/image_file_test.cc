@@ -93,6 +93,13 @@ TEST(ImageFile, HugeHeadersAreRefusedBeforeDecoding) {
                 .find("d.bmp: BMP header gives 268435456 x 8 pixels"),
             std::string::npos);
 
+  // Sizes whose product overflows 64 bits (a fuzz finding: UBSan's signed
+  // overflow in the pixel count).
+  const std::string pnm_huge = "P6 99999999999999999999 99999999999999999999 255\n";
+  EXPECT_NE(ErrorOf([&] { DecodeImageFile("g.ppm", pnm_huge, cv::IMREAD_COLOR); })
+                .find("g.ppm: PNM header gives 4294967296 x 4294967296 pixels"),
+            std::string::npos);
+
   EXPECT_NE(ErrorOf([&] { DecodeImageFile("e.pgm", "P5 0 7 255\n", cv::IMREAD_COLOR); })
                 .find("e.pgm: PNM header gives a size of 0 x 7 pixels (corrupt)"),
             std::string::npos);
@@ -109,6 +116,35 @@ TEST(ImageFile, DecodedSizeIsLimitedForTheFlagsAsked) {
   EXPECT_NE(ErrorOf([&] { DecodeImageFile("f.png", png, cv::IMREAD_UNCHANGED, "mask"); })
                 .find("f.png: PNG of 16384 x 16384 pixels would take 2048 MiB decoded, more "
                       "than the 1024 MiB read per mask"),
+            std::string::npos);
+}
+
+// A TIFF whose SamplesPerPixel is 2^32 - 1 and BitsPerSample 2^32 - 1: the
+// decoded size, computed without overflow, is refused.
+TEST(ImageFile, TiffSampleCountsCannotOverflowTheSize) {
+  std::string tif = Encode(".tif", Pattern(8, 8, CV_8UC3));
+  ASSERT_EQ(tif.compare(0, 4, "II*\0", 4), 0);
+  const auto le32 = [&](size_t i) {
+    return uint32_t(uint8_t(tif[i])) | uint32_t(uint8_t(tif[i + 1])) << 8 |
+           uint32_t(uint8_t(tif[i + 2])) << 16 | uint32_t(uint8_t(tif[i + 3])) << 24;
+  };
+  const uint32_t ifd = le32(4);
+  const int n = uint8_t(tif[ifd]) | uint8_t(tif[ifd + 1]) << 8;
+  int patched = 0;
+  for (int e = 0; e < n; ++e) {
+    const size_t entry = ifd + 2 + 12 * e;
+    const int tag = uint8_t(tif[entry]) | uint8_t(tif[entry + 1]) << 8;
+    if (tag == 258 || tag == 277) {  // BitsPerSample, SamplesPerPixel: LONG 0xffffffff
+      tif.replace(entry + 2, 10, std::string("\x04\0\x01\0\0\0\xff\xff\xff\xff", 10));
+      ++patched;
+    }
+  }
+  ASSERT_EQ(patched, 2);
+  const ImageHeader header = ReadImageHeader("s.tif", tif);
+  EXPECT_EQ(header.channels, 65535);
+  EXPECT_EQ(header.bytes_per_sample, 536870912);
+  EXPECT_NE(ErrorOf([&] { DecodeImageFile("s.tif", tif, cv::IMREAD_UNCHANGED); })
+                .find("s.tif: TIFF of 8 x 8 pixels would take"),
             std::string::npos);
 }
 
