@@ -77,7 +77,26 @@ TEST_F(MeshRefinerCli, DryRunPrintsSummaryAndWritesNothing) {
   EXPECT_NE(r.output.find("Images:      8 registered"), std::string::npos) << r.output;
   EXPECT_NE(r.output.find("Faces:       1280"), std::string::npos) << r.output;
   EXPECT_NE(r.output.find("px at full resolution"), std::string::npos) << r.output;
+  EXPECT_NE(r.output.find("Working resolution: 160x120 (largest view; 0 of 8 views scaled down"),
+            std::string::npos)
+      << r.output;
+  EXPECT_NE(r.output.find("Faces at the finest level: about"), std::string::npos) << r.output;
   EXPECT_FALSE(ExistsFile(dir_ + "/meshed-refined.ply"));
+  // --Refine.max_image_size scales the images down; the mesh follows the
+  // working resolution (a quarter of the pixels: about a quarter of the faces).
+  const auto faces_in = [](const std::string& output) {
+    const size_t at = output.find("Faces at the finest level: about ");
+    return at == std::string::npos ? -1 : std::stoi(output.substr(at + 33));
+  };
+  const CommandResult half = RunCommand(kRefiner + " --workspace_path " + dir_ +
+                                        " --dry_run --Refine.max_image_size 80");
+  ASSERT_EQ(half.exit_code, 0) << half.output;
+  EXPECT_NE(half.output.find("Working resolution: 80x60 (largest view; 8 of 8 views scaled down "
+                             "to --Refine.max_image_size 80)"),
+            std::string::npos)
+      << half.output;
+  EXPECT_NEAR(faces_in(half.output), faces_in(r.output) / 4.0, faces_in(r.output) * 0.05)
+      << r.output << half.output;
 }
 
 TEST_F(MeshRefinerCli, DryRunWithTextModel) {

@@ -57,7 +57,7 @@ void WarnIfMeaningless(const RefineSummary& summary) {
 
 // Prints the dry-run summary of a workspace and mesh.
 void PrintSummary(const Workspace& workspace, const ViewSource& source, const TriangleMesh& mesh,
-                  const std::string& input_path) {
+                  const std::string& input_path, const RefineOptions& refine) {
   const Eigen::Vector3d lo = mesh.V.colwise().minCoeff(), hi = mesh.V.colwise().maxCoeff();
   const std::vector<PinholeView> views = source.Views();
   const double footprint = MedianFootprint(views, mesh.V, VertexNormals(mesh.V, mesh.F));
@@ -77,6 +77,24 @@ void PrintSummary(const Workspace& workspace, const ViewSource& source, const Tr
   } else {
     std::printf("Mean edge:   %g (the mesh is not visible in any view)\n", edge);
   }
+  // The resolution the refinement works at, and the finest level's mesh.
+  const ResizedViewSource working(source, refine.max_image_size);
+  int largest = 0, resized = 0;
+  for (int i = 0; i < working.NumViews(); ++i) {
+    if (working.View(i).width * working.View(i).height >
+        working.View(largest).width * working.View(largest).height) {
+      largest = i;
+    }
+    resized += working.Resized(i) ? 1 : 0;
+  }
+  std::printf("Working resolution: %dx%d (largest view; %d of %d views scaled down to "
+              "--Refine.max_image_size %d)\n",
+              working.View(largest).width, working.View(largest).height, resized,
+              working.NumViews(), refine.max_image_size);
+  const int max_faces = refine.FaceBudget(mesh.NumFaces());
+  std::printf("Faces at the finest level: about %d (%.2g px edges, at most %d)\n",
+              RemeshedFaceCount(working.Views(), mesh.V, mesh.F, refine.target_edge_px, max_faces),
+              refine.target_edge_px, max_faces);
 }
 
 int Run(int argc, char** argv) {
@@ -162,7 +180,7 @@ int Run(int argc, char** argv) {
                    << " are needed for a refinement to mean anything (is it the right file?)";
   }
   if (dry_run) {
-    PrintSummary(workspace, source, mesh, input_path);
+    PrintSummary(workspace, source, mesh, input_path, refine);
     return 0;
   }
   if (!(MedianFootprint(source.Views(), mesh.V, VertexNormals(mesh.V, mesh.F)) > 0)) {

@@ -312,6 +312,9 @@ bool RefineOptions::Check() const {
   if (min_level_image_px < 16) fail("min_level_image_px", std::to_string(min_level_image_px), "min_level_image_px >= 16");
   if (iterations_per_level < 0) fail("iterations_per_level", std::to_string(iterations_per_level), "iterations_per_level >= 0");
   if (!(target_edge_px > 0)) fail("target_edge_px", std::to_string(target_edge_px), "target_edge_px > 0");
+  if (max_image_size != -1 && max_image_size < 32) {
+    fail("max_image_size", std::to_string(max_image_size), "max_image_size >= 32 or -1");
+  }
   if (max_faces < 0) fail("max_faces", std::to_string(max_faces), "max_faces >= 0");
   if (!(step > 0 && step <= 1)) fail("step", std::to_string(step), "0 < step <= 1");
   if (!(max_step_px > 0)) fail("max_step_px", std::to_string(max_step_px), "max_step_px > 0");
@@ -362,9 +365,11 @@ std::string RefineSummary::FullReport() const {
   return out.str();
 }
 
-RefineSummary RefineMesh(const ViewSource& source, const RefineOptions& options,
+RefineSummary RefineMesh(const ViewSource& input_source, const RefineOptions& options,
                          TriangleMesh* mesh, Renderer* renderer) {
   options.Check();
+  // Everything below works at the working resolution.
+  const ResizedViewSource source(input_source, options.max_image_size);
   const double t_start = ElapsedSeconds();
   if (mesh->NumFaces() == 0 || mesh->NumVertices() == 0) {
     MR_THROW_INPUT << "the input mesh is empty (" << mesh->NumVertices() << " vertices, "
@@ -411,8 +416,7 @@ RefineSummary RefineMesh(const ViewSource& source, const RefineOptions& options,
   MR_LOG(INFO) << "Selected " << pairs.size() << " view pairs among " << source.NumViews()
                << " views";
 
-  const int max_faces =
-      options.max_faces > 0 ? options.max_faces : std::max(100000, 2 * summary.initial_faces);
+  const int max_faces = options.FaceBudget(summary.initial_faces);
   const size_t cache_bytes = static_cast<size_t>(options.cache_mb) << 20;
   ImageCache images(source, cache_bytes / 2);
 
@@ -646,6 +650,9 @@ void RegisterRefineOptions(OptionManager* o, RefineOptions* r) {
          "a level ends when the mean ZNCC rose by less than this in one iteration (0: never)");
   o->Add("Refine.iterations_per_level", &r->iterations_per_level,
          "gradient + denoising iterations per level (>= 0)");
+  o->Add("Refine.max_image_size", &r->max_image_size,
+         "longest image side in pixels at which images are compared; larger images and their "
+         "cameras are scaled down (-1: no limit)");
   o->Add("Refine.target_edge_px", &r->target_edge_px,
          "target triangle edge length in pixels at each level (> 0)");
   o->Add("Refine.max_faces", &r->max_faces, "face budget (0: 2x input faces, at least 100k)");

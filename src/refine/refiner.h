@@ -4,6 +4,7 @@
 // alternates a reprojection-error gradient step (detail-preserving
 // similarity) and a content-aware L_p denoising step, coarse to fine.
 
+#include <algorithm>
 #include <string>
 #include <vector>
 
@@ -73,6 +74,12 @@ struct RefineOptions {
   // by less than this (ZNCC units, >= 0; 0 = always run
   // iterations_per_level); a last step that lowered it is taken back.
   double min_improvement = 0.0;
+  // Longest image side, in pixels, at which the images are compared: larger
+  // images are scaled down to it, their cameras with them (ResizedViewSource),
+  // as COLMAP's PatchMatchStereo.max_image_size; pyramid levels, pixel
+  // footprints and target_edge_px are then taken at this working resolution
+  // (-1: no limit; else >= 32).
+  int max_image_size = -1;
   // Target triangle edge length in pixels at every level (> 0). The mesh is
   // remeshed to it when a level starts.
   double target_edge_px = 2.5;
@@ -127,6 +134,10 @@ struct RefineOptions {
   DenoiseOptions denoise = ProximalDenoiseOptions();
 
   bool Check() const;
+  // max_faces, or its default for an input of `input_faces` faces.
+  int FaceBudget(int input_faces) const {
+    return max_faces > 0 ? max_faces : std::max(100000, 2 * input_faces);
+  }
 };
 
 struct RefineIteration {

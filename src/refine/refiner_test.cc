@@ -115,6 +115,89 @@ TEST_F(RefinerTest, NoisyMeshGetsCloserToGroundTruth) {
 }
 
 
+// --Refine.max_image_size: images and cameras scaled down together. The same
+// scene rendered at twice the size and refined at max_image_size 160 ends
+// where the 160x120 scene ends (a camera scaled wrongly by half a pixel
+// would leave every pair misaligned and the result far off).
+TEST_F(RefinerTest, MaxImageSizeWorksAtTheWorkingResolution) {
+  Eigen::MatrixXd V;
+  Eigen::MatrixXi F;
+  MakeBumpySphere(5, 0.06, &V, &F);
+  TestSceneOptions large;
+  large.width = 320;
+  large.height = 240;
+  large.supersample = 1;
+  const InMemoryViewSource small_source = MakeTestScene(V, F, {}, {}, renderer_);
+  const InMemoryViewSource large_source = MakeTestScene(V, F, large, {}, renderer_);
+  Eigen::MatrixXd V0;
+  Eigen::MatrixXi F0;
+  MakeIcosphere(4, 1.0, &V0, &F0);
+  const EvaluationResult before = Evaluate(V0, F0, V, F);
+  TriangleMesh at_small, at_large;
+  at_small.V = at_large.V = V0;
+  at_small.F = at_large.F = F0;
+  RefineMesh(small_source, FastOptions(), &at_small, renderer_);
+  RefineOptions options = FastOptions();
+  options.max_image_size = 160;
+  const RefineSummary summary = RefineMesh(large_source, options, &at_large, renderer_);
+  const EvaluationResult small_result = Evaluate(at_small.V, at_small.F, V, F);
+  const EvaluationResult large_result = Evaluate(at_large.V, at_large.F, V, F);
+  std::printf("accuracy90 %.4f -> %.4f at 160x120, %.4f at 320x240 scaled to 160; faces %d, %d\n",
+              before.accuracy90, small_result.accuracy90, large_result.accuracy90,
+              static_cast<int>(at_small.F.rows()), static_cast<int>(at_large.F.rows()));
+  EXPECT_LT(large_result.accuracy90, 0.6 * before.accuracy90) << summary.FullReport();
+  EXPECT_NEAR(large_result.accuracy90, small_result.accuracy90, 0.15 * small_result.accuracy90);
+  EXPECT_NEAR(large_result.normal_deg, small_result.normal_deg, 0.15 * small_result.normal_deg);
+  // The mesh follows the working resolution: as many faces as at 160x120.
+  EXPECT_NEAR(at_large.F.rows(), at_small.F.rows(), 0.1 * at_small.F.rows());
+}
+
+TEST(ResizedViewSource, ImagesAndCamerasScaleTogether) {
+  InMemoryViewSource base;
+  PinholeView view = LookAtView(Eigen::Vector3d(0, -4, 0), Eigen::Vector3d::Zero(),
+                                Eigen::Vector3d::UnitZ(), 401, 301, 500);
+  view.cx = 190.3;  // off centre
+  // A linear ramp in continuous image coordinates survives INTER_AREA exactly.
+  cv::Mat gray(301, 401, CV_32F), mask(301, 401, CV_8U, cv::Scalar(0));
+  for (int r = 0; r < 301; ++r) {
+    for (int c = 0; c < 401; ++c) gray.at<float>(r, c) = 0.001f * (c + 0.5f) + 0.002f * (r + 0.5f);
+  }
+  mask(cv::Rect(100, 100, 200, 100)).setTo(255);
+  base.Add("a", view, gray, mask);
+  base.Add("b", view.Scaled(0.25), cv::Mat(76, 101, CV_32F, cv::Scalar(0.5)));
+
+  const ResizedViewSource resized(base, 200);
+  const PinholeView& v = resized.View(0);
+  EXPECT_EQ(v.width, 200);  // 401 * 200 / 401
+  EXPECT_EQ(v.height, 150);  // round(301 * 200 / 401) = round(150.1)
+  EXPECT_TRUE(resized.Resized(0));
+  EXPECT_FALSE(resized.Resized(1));  // 101 x 76 is within the limit
+  EXPECT_EQ(resized.View(1).width, 101);
+  // A 3D point projects to the scaled image point, per axis.
+  const Eigen::Vector3d X(0.3, 0.2, -0.4);
+  const Eigen::Vector2d p = view.Project(X), q = v.Project(X);
+  EXPECT_NEAR(q.x(), p.x() * 200.0 / 401.0, 1e-9);
+  EXPECT_NEAR(q.y(), p.y() * 150.0 / 301.0, 1e-9);
+  // The image content follows: the ramp at a scaled pixel centre is the ramp
+  // at the corresponding full-resolution point.
+  const cv::Mat g = resized.LoadGray(0);
+  ASSERT_EQ(g.cols, 200);
+  ASSERT_EQ(g.rows, 150);
+  for (const auto& [r, c] : std::vector<std::pair<int, int>>{{10, 10}, {75, 100}, {140, 190}}) {
+    const double x = (c + 0.5) * 401.0 / 200.0, y = (r + 0.5) * 301.0 / 150.0;
+    EXPECT_NEAR(g.at<float>(r, c), 0.001 * x + 0.002 * y, 1e-4) << r << " " << c;
+  }
+  // Masks stay binary.
+  const cv::Mat m = resized.LoadMask(0);
+  ASSERT_EQ(m.size(), g.size());
+  EXPECT_EQ(cv::countNonZero((m > 0) & (m < 255)), 0);
+  EXPECT_NEAR(cv::countNonZero(m), 200 * 100 * (200.0 / 401) * (150.0 / 301), 150);
+  // No limit: everything passes through.
+  const ResizedViewSource unlimited(base, -1);
+  EXPECT_EQ(unlimited.View(0).width, 401);
+  EXPECT_EQ(unlimited.LoadGray(0).cols, 401);
+}
+
 // The schedule chooses itself: no coarse level for a start that is already
 // close (the truth), coarse levels for a far-off one (a sphere 12 % too big,
 // several pixels off in every view).

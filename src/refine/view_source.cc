@@ -1,5 +1,8 @@
 #include "refine/view_source.h"
 
+#include <algorithm>
+#include <cmath>
+
 #include <Eigen/Eigenvalues>
 #include <opencv2/imgproc.hpp>
 
@@ -162,6 +165,50 @@ cv::Mat ImageCache::Get(int kind, int i, int level) {
     entries_.erase(last);
   }
   return entries_.front().second;
+}
+
+ResizedViewSource::ResizedViewSource(const ViewSource& base, int max_image_size) : base_(base) {
+  for (int i = 0; i < base.NumViews(); ++i) {
+    PinholeView view = base.View(i);
+    const int longest = std::max(view.width, view.height);
+    if (max_image_size > 0 && longest > max_image_size) {
+      const double scale = static_cast<double>(max_image_size) / longest;
+      const int width = std::max(1, static_cast<int>(std::lround(view.width * scale)));
+      const int height = std::max(1, static_cast<int>(std::lround(view.height * scale)));
+      const double sx = static_cast<double>(width) / view.width;
+      const double sy = static_cast<double>(height) / view.height;
+      view.fx *= sx;
+      view.cx *= sx;
+      view.fy *= sy;
+      view.cy *= sy;
+      view.width = width;
+      view.height = height;
+    }
+    views_.push_back(view);
+  }
+}
+
+bool ResizedViewSource::Resized(int i) const {
+  return views_.at(i).width != base_.View(i).width || views_.at(i).height != base_.View(i).height;
+}
+
+cv::Mat ResizedViewSource::Resize(int i, const cv::Mat& image) const {
+  if (image.empty() || !Resized(i)) return image;
+  cv::Mat out;
+  cv::resize(image, out, cv::Size(views_[i].width, views_[i].height), 0, 0, cv::INTER_AREA);
+  return out;
+}
+
+cv::Mat ResizedViewSource::LoadGray(int i) const { return Resize(i, base_.LoadGray(i)); }
+
+cv::Mat ResizedViewSource::LoadColor(int i) const { return Resize(i, base_.LoadColor(i)); }
+
+cv::Mat ResizedViewSource::LoadMask(int i) const {
+  const cv::Mat mask = base_.LoadMask(i);
+  if (mask.empty() || !Resized(i)) return mask;
+  cv::Mat binary;
+  cv::threshold(Resize(i, mask), binary, 127, 255, cv::THRESH_BINARY);
+  return binary;
 }
 
 }  // namespace mr

@@ -66,6 +66,31 @@ class WorkspaceViewSource : public ViewSource {
   std::vector<PinholeView> views_;
 };
 
+// `base` with every image whose longest side exceeds `max_image_size` pixels
+// scaled down to that size (cv::INTER_AREA), and its camera with it, as
+// COLMAP's max_image_size options do: the sizes round to whole pixels, and
+// fx, cx scale by the width's ratio, fy, cy by the height's. Masks are
+// scaled the same way and thresholded at half. Smaller images pass through
+// unchanged; max_image_size <= 0 means no limit. `base` must outlive this.
+class ResizedViewSource : public ViewSource {
+ public:
+  ResizedViewSource(const ViewSource& base, int max_image_size);
+  int NumViews() const override { return base_.NumViews(); }
+  const PinholeView& View(int i) const override { return views_.at(i); }
+  std::string Name(int i) const override { return base_.Name(i); }
+  cv::Mat LoadGray(int i) const override;
+  cv::Mat LoadColor(int i) const override;
+  cv::Mat LoadMask(int i) const override;
+  bool HasMasks() const override { return base_.HasMasks(); }
+  // Whether view i is scaled down.
+  bool Resized(int i) const;
+
+ private:
+  cv::Mat Resize(int i, const cv::Mat& image) const;
+  const ViewSource& base_;
+  std::vector<PinholeView> views_;
+};
+
 // The colour direction along which the images' texture varies most: the
 // principal eigenvector of the RGB covariance of the images' high-pass part
 // (colour minus its Gaussian blur of `sigma_px`, the scale a ZNCC window
