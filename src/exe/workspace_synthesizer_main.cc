@@ -78,6 +78,13 @@ int main(int argc, char** argv) {
                 "built-in shape: target edge length (scene units)");
     options.Add("Shape.relief_amplitude", &o.builtin.relief_amplitude,
                 "built-in shape: relief amplitude (scene units)");
+    options.Add("CameraError.pose_error_px", &o.camera_error.pose_error_px,
+                "RMS reprojection error (pixels, on the surface each view sees) of a random "
+                "pose error per image in the written sparse model, [0, 100]; images and depth "
+                "maps keep the true cameras, the true model goes to DIR/sparse_true; 0 = exact");
+    options.Add("CameraError.focal_error_percent", &o.camera_error.focal_error_percent,
+                "focal length error of the written sparse model (percent, fx and fy scaled by "
+                "1 +- e, sign random per camera), [0, 50]; 0 = exact");
     options.Add("run_colmap", &o.run_colmap, "run colmap stereo_fusion and poisson_mesher");
     options.Add("colmap_path", &o.colmap.colmap_path, "colmap executable (path or name on PATH)");
     options.Add("StereoFusion.min_num_pixels", &o.colmap.fusion_min_num_pixels,

@@ -98,6 +98,7 @@ bool SynthesizerOptions::Check() const {
   noise.Check();
   if (run_colmap) colmap.Check();
   renderer.Check();
+  camera_error.Check();
   return true;
 }
 
@@ -107,6 +108,7 @@ std::string SynthesizerSummary::BriefReport() const {
     << " vertices / " << num_gt_faces << " faces; " << num_points3D
     << " sparse points (mean track " << mean_track_length << "); object covers "
     << 100 * mean_coverage << "% of the pixels";
+  if (perturbed_cameras) s << "; " << camera_error.BriefReport();
   if (ran_colmap) {
     s << "; fused " << colmap.fused_points << " points; Poisson mesh " << colmap.poisson_vertices
       << " vertices / " << colmap.poisson_faces << " faces (trim " << colmap.trim_used << ")";
@@ -234,9 +236,24 @@ SynthesizerSummary SynthesizeWorkspace(const SynthesizerOptions& options) {
 
   // Sparse model.
   t0 = ElapsedSeconds();
-  const Reconstruction model =
+  Reconstruction model =
       MakeSparseModel(scene, views, names, exact, images, options.num_sparse_points,
                       static_cast<uint32_t>(options.seed * 7919 + 17));
+  if (options.camera_error.pose_error_px > 0 || options.camera_error.focal_error_percent > 0) {
+    // The true model beside dense/, where nothing reads it by accident; the
+    // workspace gets the wrong one, to be fused with the true depth maps.
+    const std::string true_dir = JoinPaths(options.output_path, "sparse_true");
+    CreateDirIfNotExists(true_dir);
+    WriteSparseModelBinary(true_dir, model);
+    summary.camera_error = PerturbCameras(options.camera_error, gt.V,
+                                          static_cast<uint32_t>(options.seed) * 104729u + 101u,
+                                          &model);
+    summary.perturbed_cameras = true;
+    MR_LOG(INFO) << "Sparse model perturbed (pose_error_px " << options.camera_error.pose_error_px
+                 << ", focal_error_percent " << options.camera_error.focal_error_percent
+                 << "; true model in " << true_dir << "): "
+                 << summary.camera_error.BriefReport();
+  }
   WriteSparseModelBinary(sparse_dir, model);
   summary.num_points3D = static_cast<int>(model.points3D.size());
   size_t track_sum = 0;

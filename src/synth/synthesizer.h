@@ -7,7 +7,10 @@
 //   output_path/ground_truth.ply          the normalised ground truth
 //   output_path/dense/images/view_NNNN.png   anti-aliased RGB renders
 //   output_path/dense/masks/view_NNNN.png.png  (write_masks) 255 = object
-//   output_path/dense/sparse/{cameras,images,points3D}.bin
+//   output_path/dense/sparse/{cameras,images,points3D}.bin  (with camera_error:
+//                                          the perturbed model)
+//   output_path/sparse_true/{cameras,images,points3D}.bin  (only with
+//                                          camera_error: the true model)
 //   output_path/dense/stereo/{depth_maps,normal_maps}/<name>.geometric.bin
 //   output_path/dense/stereo/{fusion,patch-match}.cfg
 //   output_path/dense/fused.ply, meshed-poisson.ply  (run_colmap: real colmap)
@@ -16,6 +19,7 @@
 #include <string>
 
 #include "render/renderer.h"
+#include "synth/camera_error.h"
 #include "synth/colmap_runner.h"
 #include "synth/scene.h"
 #include "synth/shape.h"
@@ -57,6 +61,10 @@ struct SynthesizerOptions {
   DepthNoiseOptions noise;
   ColmapRunOptions colmap;
   RendererOptions renderer;
+  // Error of the written sparse model (poses, focal lengths) as from SfM; the
+  // images and depth maps stay rendered with the true cameras, the true model
+  // goes to output_path/sparse_true/. Seeded by `seed`.
+  CameraErrorOptions camera_error;
 
   bool Check() const;
 };
@@ -68,6 +76,8 @@ struct SynthesizerSummary {
   int num_points3D = 0;
   double mean_track_length = 0;
   double mean_coverage = 0;  // mean fraction of image pixels showing the object
+  bool perturbed_cameras = false;  // camera_error applied to dense/sparse
+  CameraErrorSummary camera_error;
   bool ran_colmap = false;
   ColmapRunSummary colmap;
   double render_seconds = 0;

@@ -1,0 +1,230 @@
+#include "synth/camera_error.h"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <random>
+#include <sstream>
+
+#include <Eigen/Geometry>
+
+#include "colmap_io/camera_models.h"
+#include "util/error.h"
+#include "util/logging.h"
+
+namespace mr {
+namespace {
+
+constexpr double kPi = 3.14159265358979323846;
+constexpr double kInf = std::numeric_limits<double>::infinity();
+// Relative tolerance of the achieved RMS (the promise is 1 %).
+constexpr double kRmsTolerance = 1e-3;
+
+// The surface points one view sees: camera-frame coordinates and projections.
+struct VisiblePoints {
+  std::vector<Eigen::Vector3d> camera;
+  std::vector<Eigen::Vector2d> image;
+};
+
+VisiblePoints FindVisible(const PinholeView& view, const Eigen::MatrixXd& points) {
+  VisiblePoints visible;
+  for (Eigen::Index k = 0; k < points.rows(); ++k) {
+    const Eigen::Vector3d Xc = view.WorldToCamera(points.row(k).transpose());
+    if (!(Xc.z() > 0)) continue;
+    const Eigen::Vector2d p = view.CameraToImage(Xc);
+    if (!view.InImage(p)) continue;
+    visible.camera.push_back(Xc);
+    visible.image.push_back(p);
+  }
+  return visible;
+}
+
+// Rotation exp([w]x) (Rodrigues).
+Eigen::Matrix3d ExpRotation(const Eigen::Vector3d& w) {
+  const double angle = w.norm();
+  if (angle == 0) return Eigen::Matrix3d::Identity();
+  return Eigen::AngleAxisd(angle, w / angle).toRotationMatrix();
+}
+
+// RMS displacement of the visible points' projections when the camera is
+// rotated by exp([w]x) (camera side) and its centre moved by `shift_camera`
+// (the world shift expressed in the camera frame): X'c = exp([w]x) (Xc - shift).
+double DisplacementRms(const PinholeView& view, const VisiblePoints& visible,
+                       const Eigen::Vector3d& w, const Eigen::Vector3d& shift_camera) {
+  const Eigen::Matrix3d dR = ExpRotation(w);
+  double sum = 0;
+  for (size_t k = 0; k < visible.camera.size(); ++k) {
+    const Eigen::Vector3d Xc = dR * (visible.camera[k] - shift_camera);
+    if (!(Xc.z() > 0)) return kInf;
+    sum += (view.CameraToImage(Xc) - visible.image[k]).squaredNorm();
+  }
+  return std::sqrt(sum / visible.camera.size());
+}
+
+double Median(std::vector<double> values) {
+  MR_CHECK(!values.empty());
+  const size_t mid = values.size() / 2;
+  std::nth_element(values.begin(), values.begin() + mid, values.end());
+  return values[mid];
+}
+
+// The scale s >= 0 of the motion direction (w, shift_camera) whose RMS
+// displacement is `target` (> 0) within kRmsTolerance; `rms` receives it.
+double SolveScale(const PinholeView& view, const VisiblePoints& visible, const Eigen::Vector3d& w,
+                  const Eigen::Vector3d& shift_camera, double target, double* rms) {
+  const auto f = [&](double s) { return DisplacementRms(view, visible, s * w, s * shift_camera); };
+  // Probe: a motion far below a pixel, where the displacement is linear in s.
+  const double probe = 1e-6;
+  const double f_probe = f(probe);
+  MR_CHECK(f_probe > 0 && std::isfinite(f_probe)) << "degenerate motion direction";
+  double lo = 0, hi = kInf;  // f(lo) < target <= f(hi)
+  double prev_s = 0, prev_f = 0;
+  double s = target * probe / f_probe;
+  for (int iteration = 0; iteration < 100; ++iteration) {
+    const double value = f(s);
+    if (std::abs(value - target) <= kRmsTolerance * target) {
+      *rms = value;
+      return s;
+    }
+    if (value < target) {
+      lo = s;
+    } else {
+      hi = s;
+    }
+    // Secant step through the last two values; bisection (or doubling, with
+    // no upper bound yet) when it leaves the bracket.
+    double next = std::isfinite(value) && value != prev_f
+                      ? s + (target - value) * (s - prev_s) / (value - prev_f)
+                      : std::numeric_limits<double>::quiet_NaN();
+    if (!(next > lo && next < hi)) next = std::isfinite(hi) ? 0.5 * (lo + hi) : 2 * s;
+    prev_s = s;
+    prev_f = value;
+    s = next;
+  }
+  MR_CHECK(false) << "pose error: no scale reaches " << target << " px (bracket " << lo << ", "
+                  << hi << ")";
+  return 0;
+}
+
+}  // namespace
+
+bool CameraErrorOptions::Check() const {
+  if (!(pose_error_px >= 0 && pose_error_px <= 100)) {
+    MR_THROW_INPUT << "CameraErrorOptions::pose_error_px = " << pose_error_px
+                   << ". Violated constraint: 0 <= pose_error_px <= 100";
+  }
+  if (!(focal_error_percent >= 0 && focal_error_percent <= 50)) {
+    MR_THROW_INPUT << "CameraErrorOptions::focal_error_percent = " << focal_error_percent
+                   << ". Violated constraint: 0 <= focal_error_percent <= 50";
+  }
+  return true;
+}
+
+std::string CameraErrorSummary::BriefReport() const {
+  std::ostringstream s;
+  s << "camera error: pose RMS " << mean_rms_px << " px mean, " << max_rms_px << " max over "
+    << num_perturbed_images << " images";
+  if (static_cast<int>(images.size()) > num_perturbed_images) {
+    s << " (" << images.size() - num_perturbed_images << " seeing no surface left exact)";
+  }
+  s << "; rotation " << mean_rotation_deg << " deg mean, " << max_rotation_deg
+    << " max; centre shift " << mean_center_shift << " mean, " << max_center_shift
+    << " max; focal scale";
+  for (const auto& [id, scale] : focal_scale) s << " " << scale;
+  return s.str();
+}
+
+double ReprojectionRms(const PinholeView& true_view, const PinholeView& other_view,
+                       const Eigen::MatrixXd& surface_points, int* num_visible) {
+  MR_CHECK_EQ(surface_points.cols(), 3);
+  const VisiblePoints visible = FindVisible(true_view, surface_points);
+  if (num_visible != nullptr) *num_visible = static_cast<int>(visible.camera.size());
+  if (visible.camera.empty()) return 0;
+  double sum = 0;
+  for (size_t k = 0; k < visible.camera.size(); ++k) {
+    const Eigen::Vector3d Xc =
+        other_view.WorldToCamera(true_view.R.transpose() * (visible.camera[k] - true_view.t));
+    if (!(Xc.z() > 0)) return kInf;
+    sum += (other_view.CameraToImage(Xc) - visible.image[k]).squaredNorm();
+  }
+  return std::sqrt(sum / visible.camera.size());
+}
+
+CameraErrorSummary PerturbCameras(const CameraErrorOptions& options,
+                                  const Eigen::MatrixXd& surface_points, uint32_t seed,
+                                  Reconstruction* model) {
+  options.Check();
+  MR_CHECK(model != nullptr);
+  MR_CHECK_EQ(surface_points.cols(), 3);
+  CameraErrorSummary summary;
+
+  // Poses first, with the true intrinsics. Separate random streams for poses
+  // and focal lengths, so that each error is the same with or without the other.
+  if (options.pose_error_px > 0) {
+    std::mt19937 rng(seed);
+    std::normal_distribution<double> gauss(0.0, 1.0);
+    for (auto& [image_id, image] : model->images) {
+      // Draw before anything can skip the image, so that the draws of the
+      // other images do not depend on it.
+      Eigen::Vector3d w, u;
+      for (int c = 0; c < 3; ++c) w(c) = gauss(rng);
+      for (int c = 0; c < 3; ++c) u(c) = gauss(rng);
+      ImageCameraError record;
+      record.image_id = image_id;
+      const auto camera = model->cameras.find(image.camera_id);
+      MR_CHECK(camera != model->cameras.end()) << "image " << image_id << ": no camera";
+      const PinholeView view = ViewFromColmap(camera->second, image);
+      const VisiblePoints visible = FindVisible(view, surface_points);
+      record.num_visible_points = static_cast<int>(visible.camera.size());
+      if (visible.camera.empty()) {
+        MR_LOG(WARNING) << "image " << image.name
+                        << " sees no surface point; its pose is left exact";
+        summary.images.push_back(record);
+        continue;
+      }
+      std::vector<double> depths;
+      depths.reserve(visible.camera.size());
+      for (const Eigen::Vector3d& Xc : visible.camera) depths.push_back(Xc.z());
+      const Eigen::Vector3d shift_world = u * Median(depths);
+      const double s = SolveScale(view, visible, w, view.R * shift_world,
+                                  options.pose_error_px, &record.rms_px);
+      const Eigen::Matrix3d R = ExpRotation(s * w) * view.R;
+      const Eigen::Vector3d C = view.Center() + s * shift_world;
+      image.qvec = RotationToQuaternion(R);
+      image.tvec = -R * C;
+      record.rotation_deg = s * w.norm() * 180 / kPi;
+      record.center_shift = s * shift_world.norm();
+      summary.images.push_back(record);
+      ++summary.num_perturbed_images;
+      summary.mean_rms_px += record.rms_px;
+      summary.mean_rotation_deg += record.rotation_deg;
+      summary.mean_center_shift += record.center_shift;
+      summary.max_rms_px = std::max(summary.max_rms_px, record.rms_px);
+      summary.max_rotation_deg = std::max(summary.max_rotation_deg, record.rotation_deg);
+      summary.max_center_shift = std::max(summary.max_center_shift, record.center_shift);
+    }
+    if (summary.num_perturbed_images > 0) {
+      summary.mean_rms_px /= summary.num_perturbed_images;
+      summary.mean_rotation_deg /= summary.num_perturbed_images;
+      summary.mean_center_shift /= summary.num_perturbed_images;
+    }
+  }
+
+  // Focal lengths: f (SIMPLE_* models) or fx and fy, the first parameters.
+  std::mt19937 focal_rng(seed ^ 0x9e3779b9u);
+  const double e = options.focal_error_percent / 100;
+  for (auto& [camera_id, camera] : model->cameras) {
+    if (e == 0) {
+      summary.focal_scale[camera_id] = 1;
+      continue;
+    }
+    const double scale = (focal_rng() & 1u) ? 1 + e : 1 - e;
+    const int num_focal = HasSeparateFocalLengths(camera.model) ? 2 : 1;
+    MR_CHECK_GE(static_cast<int>(camera.params.size()), num_focal);
+    for (int k = 0; k < num_focal; ++k) camera.params[k] *= scale;
+    summary.focal_scale[camera_id] = scale;
+  }
+  return summary;
+}
+
+}  // namespace mr
