@@ -67,6 +67,10 @@ TEST_F(MeshRefinerCli, Nominal) {
   EXPECT_EQ(out.C.rows(), out.NumVertices()) << "vertex colours expected";
   EXPECT_NE(r.output.find("DCV refinement: FINISHED"), std::string::npos) << r.output;
   EXPECT_NE(r.output.find("Renderer:"), std::string::npos) << r.output;
+  // Progress: each iteration's line ends with an ETA; the summary splits the time.
+  EXPECT_NE(r.output.find("Level 0 iteration 2/2:"), std::string::npos) << r.output;
+  EXPECT_NE(r.output.find("; ETA 0.0 s"), std::string::npos) << r.output;
+  EXPECT_NE(r.output.find("  time: setup "), std::string::npos) << r.output;
   // No temporary file left behind.
   for (const auto& name : ListFiles(dir_)) EXPECT_EQ(name.find(".tmp."), std::string::npos) << name;
 }

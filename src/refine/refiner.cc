@@ -354,6 +354,18 @@ std::string RefineSummary::FullReport() const {
       << " vertex moves reset), self-intersections left " << self_intersections << "\n";
   out << "  surface moved: mean " << mean_displacement << ", max " << max_displacement
       << " (scene units; distance of the result's vertices to the input surface)\n";
+  double data = 0, silhouette = 0, denoise = 0, cleanup = 0, iterating = 0;
+  for (const auto& it : iterations) {
+    data += it.data_seconds;
+    silhouette += it.silhouette_seconds;
+    denoise += it.denoise_seconds;
+    cleanup += it.cleanup_seconds;
+    iterating += it.seconds;
+  }
+  out << std::setprecision(3) << "  time: setup " << setup_seconds << " s, remeshing "
+      << remesh_seconds << " s, iterations " << iterating << " s (data " << data
+      << ", silhouette " << silhouette << ", denoise " << denoise << ", clean-up " << cleanup
+      << "), final " << final_seconds << " s\n";
   out << "  level iter  faces  similarity  kappa  step_px(mean/max)  regulariser  seconds\n";
   for (const auto& it : iterations) {
     out << "  " << std::setw(5) << it.level << std::setw(5) << it.iteration << std::setw(7)
@@ -465,9 +477,11 @@ RefineSummary RefineMesh(const ViewSource& input_source, const RefineOptions& op
   const int total_iterations = num_levels * options.iterations_per_level;
   int global_iteration = 0;
   bool guard_verified_clean = false;  // the last iteration's guard found no intersection
+  summary.setup_seconds = ElapsedSeconds() - t_start;
   for (int level = num_levels - 1; level >= 0; --level) {
     const std::vector<PinholeView> views = ScaledViews(source, level);
     RemeshForLevel(views, options, max_faces, &V, &F);
+    double level_seconds = 0;  // of this level's iterations so far, for the ETA
     guard_verified_clean = false;
     // The iterations start from a mesh without self-intersections (what the
     // repair cannot remove is tolerated, and only new ones are undone).
@@ -600,17 +614,31 @@ RefineSummary RefineMesh(const ViewSource& input_source, const RefineOptions& op
 
       record.cleanup_seconds = ElapsedSeconds() - t_cleanup;
       record.seconds = ElapsedSeconds() - t_iter;
+      // ETA: this level's mean iteration for what is left of it; each finer
+      // level has 4x the pixels and, at the same edge length in pixels, about
+      // 4x the faces.
+      level_seconds += record.seconds;
+      const double mean_seconds = level_seconds / (it + 1);
+      double eta = (options.iterations_per_level - it - 1) * mean_seconds;
+      for (int finer = level - 1; finer >= 0; --finer) {
+        eta += options.iterations_per_level * mean_seconds * std::pow(4.0, level - finer);
+      }
       MR_LOG(INFO) << "Level " << level << " iteration " << it + 1 << "/"
                    << options.iterations_per_level << ": similarity " << record.mean_similarity
                    << ", step " << record.mean_step_px << " px (max " << record.max_step_px
                    << "), " << record.regularizer_report << "; " << record.seconds
                    << " s (data " << record.data_seconds << ", silhouette "
                    << record.silhouette_seconds << ", denoise " << record.denoise_seconds
-                   << ", clean-up " << record.cleanup_seconds << ")";
+                   << ", clean-up " << record.cleanup_seconds << "); ETA "
+                   << FormatSeconds(eta);
       summary.iterations.push_back(record);
     }
   }
 
+  const double t_final = ElapsedSeconds();
+  // Everything of the levels but their iterations: remeshing, guards, caches.
+  summary.remesh_seconds = t_final - t_start - summary.setup_seconds;
+  for (const auto& it : summary.iterations) summary.remesh_seconds -= it.seconds;
   // Leave no self-intersection behind (the flow can fold thin parts). When
   // the last iteration's guard already checked the mesh and found none, that
   // check stands.
@@ -635,6 +663,7 @@ RefineSummary RefineMesh(const ViewSource& input_source, const RefineOptions& op
   summary.final_faces = mesh->NumFaces();
   summary.final_vertices = mesh->NumVertices();
   summary.termination = "FINISHED";
+  summary.final_seconds = ElapsedSeconds() - t_final;
   summary.seconds = ElapsedSeconds() - t_start;
   return summary;
 }

@@ -177,6 +177,11 @@ struct RefineSummary {
   // scene units: how far the refinement moved the surface.
   double mean_displacement = 0, max_displacement = 0;
   double seconds = 0;
+  // Where the time went outside the iterations: loading the mesh, cleaning
+  // it, view selection and the schedule; remeshing for the levels (and the
+  // rest of their set-up: the self-intersection guard, the render cache); the final self-intersection check,
+  // similarity and vertex colours.
+  double setup_seconds = 0, remesh_seconds = 0, final_seconds = 0;
   std::vector<RefineIteration> iterations;
 
   std::string BriefReport() const;

@@ -112,6 +112,13 @@ TEST_F(RefinerTest, NoisyMeshGetsCloserToGroundTruth) {
   EXPECT_LT(after.accuracy90, 0.6 * before.accuracy90) << summary.FullReport();
   EXPECT_LT(after.normal_deg, before.normal_deg) << summary.FullReport();
   EXPECT_GT(summary.final_similarity, summary.initial_similarity);
+  // The time split accounts for the whole run.
+  double iterating = 0;
+  for (const auto& it : summary.iterations) iterating += it.seconds;
+  EXPECT_NEAR(summary.setup_seconds + summary.remesh_seconds + iterating + summary.final_seconds,
+              summary.seconds, 0.02 * summary.seconds + 0.05)
+      << summary.FullReport();
+  EXPECT_NE(summary.FullReport().find("  time: setup "), std::string::npos);
 }
 
 
