@@ -1,0 +1,772 @@
+#include "refine/camera_refinement.h"
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <iomanip>
+#include <map>
+#include <memory>
+#include <sstream>
+#include <unordered_map>
+
+#include <Eigen/Geometry>
+#include <ceres/ceres.h>
+
+#include "geometry/mesh.h"
+#include "refine/pyramid.h"
+#include "render/renderer.h"
+#include "util/error.h"
+#include "util/logging.h"
+
+namespace mr {
+namespace internal {
+namespace {
+
+using RowMatrix3d = Eigen::Matrix<double, 3, 3, Eigen::RowMajor>;
+
+// Samples seen at |cos(ray, normal)| below this (60 degrees) in either view
+// are dropped: a pixel's footprint maps onto a strongly anisotropic area in
+// the other view there, which the point-wise comparison does not model (on
+// the test scene, 0.2 instead of 0.5 triples the drift from the true poses).
+constexpr double kMinCosAngle = 0.5;
+// I_i(p) and the bilinear stencil of I_j(q) must lie inside the surface: the
+// (2 kMargin + 1)^2 pixels around p, and around q's pixel, see the surface
+// (no silhouette blend; in j, at the point's depth).
+constexpr int kMargin = 2;
+// Depth test in view j: within this many pixel footprints / cos of the
+// rendered depth (as PairTermOptions::visibility_tolerance_px).
+constexpr double kVisibilityTolerancePx = 1.5;
+// Projections closer than this to the border of image j are dropped, so that
+// a pose change of a pixel or two keeps the bilinear stencil inside.
+constexpr double kBorderPx = 3.0;
+// Samples with a weaker gradient in view j carry no pose information.
+constexpr double kMinGradient = 1e-3;
+
+// The residual and its Jacobian with respect to every parameter (any pointer
+// may be null). Returns false where the warp is undefined (ray parallel to
+// the plane, plane behind camera i, point behind camera j).
+bool EvaluatePhotometric(const PhotometricSample& s, const cv::Mat& image_j, const double* Ri_p,
+                         const double* Ci_p, const double* Ki, const double* Rj_p,
+                         const double* Cj_p, const double* Kj, const double* ab, double* residual,
+                         double* J_Ri, double* J_Ci, double* J_Ki, double* J_Rj, double* J_Cj,
+                         double* J_Kj, double* J_ab) {
+  const Eigen::Map<const RowMatrix3d> Ri(Ri_p), Rj(Rj_p);
+  const Eigen::Map<const Eigen::Vector3d> Ci(Ci_p), Cj(Cj_p);
+  // Back-projection: m = K_i⁻¹ (p, 1), ray w = R_iᵀ m, hit X = C_i + d w.
+  const Eigen::Vector3d m((s.point.x() - Ki[2]) / Ki[0], (s.point.y() - Ki[3]) / Ki[1], 1.0);
+  const Eigen::Vector3d w = Ri.transpose() * m;
+  const double nw = s.normal.dot(w);
+  if (!(std::abs(nw) > 1e-12)) return false;
+  const double d = (s.plane_offset - s.normal.dot(Ci)) / nw;
+  if (!(d > 0)) return false;
+  const Eigen::Vector3d X = Ci + d * w;
+  // Projection into view j.
+  const Eigen::Vector3d y = X - Cj;
+  const Eigen::Vector3d Xc = Rj * y;
+  if (!(Xc.z() > 1e-12)) return false;
+  const double iz = 1.0 / Xc.z();
+  const double u = Xc.x() * iz, v = Xc.y() * iz;
+  Eigen::Vector2d g;
+  const double intensity_j = SampleBilinear(image_j, Kj[0] * u + Kj[2], Kj[1] * v + Kj[3], &g);
+  residual[0] = intensity_j - (ab[0] * s.intensity + ab[1]);
+
+  if (J_ab != nullptr) {
+    J_ab[0] = -s.intensity;
+    J_ab[1] = -1.0;
+  }
+  if (J_Kj != nullptr) {
+    J_Kj[0] = g.x() * u;
+    J_Kj[1] = g.y() * v;
+    J_Kj[2] = g.x();
+    J_Kj[3] = g.y();
+  }
+  if (J_Ri == nullptr && J_Ci == nullptr && J_Ki == nullptr && J_Rj == nullptr && J_Cj == nullptr) {
+    return true;
+  }
+  // G = ∂r/∂X_c = ∇I_jᵀ ∂q/∂X_c.
+  const Eigen::RowVector3d G(g.x() * Kj[0] * iz, g.y() * Kj[1] * iz,
+                             -(g.x() * Kj[0] * u + g.y() * Kj[1] * v) * iz);
+  if (J_Rj != nullptr) {
+    // X_c = R_j y: ∂X_c(r)/∂R_j(r, c) = y(c).
+    for (int r = 0; r < 3; ++r) {
+      for (int c = 0; c < 3; ++c) J_Rj[3 * r + c] = G(r) * y(c);
+    }
+  }
+  const Eigen::RowVector3d H = G * Rj;  // ∂r/∂X
+  if (J_Cj != nullptr) {
+    for (int k = 0; k < 3; ++k) J_Cj[k] = -H(k);
+  }
+  // X moves along the ray onto the plane: ∂X/∂C_i = I - w nᵀ / (n·w),
+  // ∂X/∂w = d (I - w nᵀ / (n·w)).
+  const Eigen::RowVector3d HP = H - (H.dot(w) / nw) * s.normal.transpose();
+  if (J_Ci != nullptr) {
+    for (int k = 0; k < 3; ++k) J_Ci[k] = HP(k);
+  }
+  const Eigen::RowVector3d E = d * HP;  // ∂r/∂w
+  if (J_Ri != nullptr) {
+    // w = R_iᵀ m: ∂w(c)/∂R_i(r, c) = m(r).
+    for (int r = 0; r < 3; ++r) {
+      for (int c = 0; c < 3; ++c) J_Ri[3 * r + c] = E(c) * m(r);
+    }
+  }
+  if (J_Ki != nullptr) {
+    const Eigen::Vector3d dm = Ri * E.transpose();  // ∂r/∂m
+    J_Ki[0] = -dm(0) * m(0) / Ki[0];
+    J_Ki[1] = -dm(1) * m(1) / Ki[1];
+    J_Ki[2] = -dm(0) / Ki[0];
+    J_Ki[3] = -dm(1) / Ki[1];
+  }
+  return true;
+}
+
+// Parameters: R_i, C_i, K_i, R_j, C_j, K_j, (a, b).
+class PhotometricCost : public ceres::SizedCostFunction<1, 9, 3, 4, 9, 3, 4, 2> {
+ public:
+  PhotometricCost(const PhotometricSample& sample, const cv::Mat& image_j)
+      : sample_(sample), image_j_(image_j) {}
+  bool Evaluate(double const* const* p, double* residual, double** J) const override {
+    const auto jac = [J](int k) { return J == nullptr ? nullptr : J[k]; };
+    return EvaluatePhotometric(sample_, image_j_, p[0], p[1], p[2], p[3], p[4], p[5], p[6],
+                               residual, jac(0), jac(1), jac(2), jac(3), jac(4), jac(5), jac(6));
+  }
+
+ private:
+  PhotometricSample sample_;
+  cv::Mat image_j_;
+};
+
+// Views i and j of one camera: R_i, C_i, R_j, C_j, K, (a, b).
+class SharedIntrinsicsPhotometricCost : public ceres::SizedCostFunction<1, 9, 3, 9, 3, 4, 2> {
+ public:
+  SharedIntrinsicsPhotometricCost(const PhotometricSample& sample, const cv::Mat& image_j)
+      : sample_(sample), image_j_(image_j) {}
+  bool Evaluate(double const* const* p, double* residual, double** J) const override {
+    const auto jac = [J](int k) { return J == nullptr ? nullptr : J[k]; };
+    double J_Ki[4], J_Kj[4];
+    const bool want_k = jac(4) != nullptr;
+    if (!EvaluatePhotometric(sample_, image_j_, p[0], p[1], p[4], p[2], p[3], p[4], p[5], residual,
+                             jac(0), jac(1), want_k ? J_Ki : nullptr, jac(2), jac(3),
+                             want_k ? J_Kj : nullptr, jac(5))) {
+      return false;
+    }
+    if (want_k) {
+      for (int k = 0; k < 4; ++k) J[4][k] = J_Ki[k] + J_Kj[k];
+    }
+    return true;
+  }
+
+ private:
+  PhotometricSample sample_;
+  cv::Mat image_j_;
+};
+
+Eigen::Matrix3d Hat(const Eigen::Vector3d& v) {
+  Eigen::Matrix3d h;
+  h << 0, -v.z(), v.y(), v.z(), 0, -v.x(), -v.y(), v.x(), 0;
+  return h;
+}
+
+Eigen::Matrix3d ExpRotation(const Eigen::Vector3d& omega) {
+  const double angle = omega.norm();
+  if (angle == 0) return Eigen::Matrix3d::Identity();
+  return Eigen::AngleAxisd(angle, omega / angle).toRotationMatrix();
+}
+
+Eigen::Vector3d LogRotation(const Eigen::Matrix3d& R) {
+  const Eigen::AngleAxisd aa(R);
+  return aa.angle() * aa.axis();
+}
+
+class RotationMatrixManifold : public ceres::Manifold {
+ public:
+  int AmbientSize() const override { return 9; }
+  int TangentSize() const override { return 3; }
+  bool Plus(const double* x, const double* delta, double* x_plus_delta) const override {
+    Eigen::Map<RowMatrix3d> out(x_plus_delta);
+    out = ExpRotation(Eigen::Vector3d(delta[0], delta[1], delta[2])) *
+          Eigen::Map<const RowMatrix3d>(x);
+    return true;
+  }
+  bool PlusJacobian(const double* x, double* jacobian) const override {
+    // Column k: Hat(e_k) R, row-major entries.
+    const Eigen::Map<const RowMatrix3d> R(x);
+    Eigen::Map<Eigen::Matrix<double, 9, 3, Eigen::RowMajor>> J(jacobian);
+    for (int k = 0; k < 3; ++k) {
+      const RowMatrix3d D = Hat(Eigen::Vector3d::Unit(k)) * R;
+      for (int e = 0; e < 9; ++e) J(e, k) = D(e / 3, e % 3);
+    }
+    return true;
+  }
+  bool Minus(const double* y, const double* x, double* y_minus_x) const override {
+    const Eigen::Matrix3d D =
+        Eigen::Map<const RowMatrix3d>(y) * Eigen::Map<const RowMatrix3d>(x).transpose();
+    Eigen::Map<Eigen::Vector3d> out(y_minus_x);
+    out = LogRotation(D);
+    return true;
+  }
+  bool MinusJacobian(const double* x, double* jacobian) const override {
+    // Minus(Y, X) = vee(skew(Y Xᵀ)) to first order at Y = X; with A = dY Xᵀ,
+    // δ0 = (A21 - A12) / 2, δ1 = (A02 - A20) / 2, δ2 = (A10 - A01) / 2 and
+    // ∂A(a, b)/∂Y(a, c) = X(b, c).
+    const Eigen::Map<const RowMatrix3d> X(x);
+    Eigen::Map<Eigen::Matrix<double, 3, 9, Eigen::RowMajor>> J(jacobian);
+    J.setZero();
+    const int pairs[3][2] = {{2, 1}, {0, 2}, {1, 0}};
+    for (int k = 0; k < 3; ++k) {
+      const int a = pairs[k][0], b = pairs[k][1];
+      for (int c = 0; c < 3; ++c) {
+        J(k, 3 * a + c) += 0.5 * X(b, c);
+        J(k, 3 * b + c) -= 0.5 * X(a, c);
+      }
+    }
+    return true;
+  }
+};
+
+// Prior on a rotation (row-major 9 values): vee(skew(R R0ᵀ)) / sigma, which
+// is sin(angle) * axis / sigma.
+struct RotationPrior {
+  RotationPrior(const Eigen::Matrix3d& R0, double sigma) : R0(R0), inv_sigma(1.0 / sigma) {}
+  template <typename T>
+  bool operator()(const T* R, T* residual) const {
+    T D[3][3];  // R R0ᵀ
+    for (int a = 0; a < 3; ++a) {
+      for (int b = 0; b < 3; ++b) {
+        D[a][b] = R[3 * a] * R0(b, 0) + R[3 * a + 1] * R0(b, 1) + R[3 * a + 2] * R0(b, 2);
+      }
+    }
+    residual[0] = 0.5 * (D[2][1] - D[1][2]) * inv_sigma;
+    residual[1] = 0.5 * (D[0][2] - D[2][0]) * inv_sigma;
+    residual[2] = 0.5 * (D[1][0] - D[0][1]) * inv_sigma;
+    return true;
+  }
+  Eigen::Matrix3d R0;
+  double inv_sigma;
+};
+
+struct CenterPrior {
+  CenterPrior(const Eigen::Vector3d& C0, double sigma) : C0(C0), inv_sigma(1.0 / sigma) {}
+  template <typename T>
+  bool operator()(const T* C, T* residual) const {
+    for (int k = 0; k < 3; ++k) residual[k] = (C[k] - C0(k)) * inv_sigma;
+    return true;
+  }
+  Eigen::Vector3d C0;
+  double inv_sigma;
+};
+
+// Prior on fx and fy of an intrinsics block (fx, fy, cx, cy).
+struct FocalPrior {
+  FocalPrior(double fx0, double fy0, double sigma_fraction)
+      : fx0(fx0),
+        fy0(fy0),
+        inv_sx(1.0 / (sigma_fraction * fx0)),
+        inv_sy(1.0 / (sigma_fraction * fy0)) {}
+  template <typename T>
+  bool operator()(const T* K, T* residual) const {
+    residual[0] = (K[0] - fx0) * inv_sx;
+    residual[1] = (K[1] - fy0) * inv_sy;
+    return true;
+  }
+  double fx0, fy0, inv_sx, inv_sy;
+};
+
+}  // namespace
+
+ceres::CostFunction* NewPhotometricCost(const PhotometricSample& sample, const cv::Mat& image_j,
+                                        bool shared_intrinsics) {
+  MR_CHECK_EQ(image_j.type(), CV_32F);
+  if (shared_intrinsics) return new SharedIntrinsicsPhotometricCost(sample, image_j);
+  return new PhotometricCost(sample, image_j);
+}
+
+ceres::Manifold* NewRotationMatrixManifold() { return new RotationMatrixManifold(); }
+
+std::vector<PhotometricSample> SelectSamples(const Eigen::MatrixXd& V, const Eigen::MatrixXi& F,
+                                             const Eigen::MatrixXd& face_normals,
+                                             const PinholeView& view_i,
+                                             const RenderBuffers& render_i, const cv::Mat& image_i,
+                                             const PinholeView& view_j,
+                                             const RenderBuffers& render_j, const cv::Mat& image_j,
+                                             int max_samples) {
+  MR_CHECK_EQ(render_i.width, view_i.width);
+  MR_CHECK_EQ(render_j.width, view_j.width);
+  const int wi = view_i.width, hi = view_i.height, wj = view_j.width, hj = view_j.height;
+  const Eigen::Vector3d Ci = view_i.Center();
+  const Eigen::Vector3d Cj = view_j.Center();
+  const auto foreground_i = [&](int r, int c) {
+    return r >= 0 && c >= 0 && r < hi && c < wi && render_i.FaceAt(r, c) >= 0;
+  };
+  std::vector<PhotometricSample> candidates;
+  for (int r = 0; r < hi; ++r) {
+    for (int c = 0; c < wi; ++c) {
+      const int f = render_i.FaceAt(r, c);
+      if (f < 0) continue;
+      // I_i(p) must be a pixel of the surface alone (no silhouette blend).
+      bool interior = true;
+      for (int dr = -kMargin; dr <= kMargin && interior; ++dr) {
+        for (int dc = -kMargin; dc <= kMargin && interior; ++dc) {
+          interior = foreground_i(r + dr, c + dc);
+        }
+      }
+      if (!interior) continue;
+      const Eigen::Vector3d n = face_normals.row(f);
+      const Eigen::Vector3d ray = view_i.RayDirection(c + 0.5, r + 0.5);
+      if (std::abs(n.dot(ray.normalized())) < kMinCosAngle) continue;
+      const double offset = n.dot(Eigen::Vector3d(V.row(F(f, 0))));
+      const double d = (offset - n.dot(Ci)) / n.dot(ray);
+      if (!(d > 0)) continue;
+      const Eigen::Vector3d X = Ci + d * ray;
+      const Eigen::Vector3d xj = view_j.WorldToCamera(X);
+      if (!(xj.z() > 0)) continue;
+      const Eigen::Vector2d q = view_j.CameraToImage(xj);
+      if (!(q.x() >= kBorderPx && q.y() >= kBorderPx && q.x() <= wj - kBorderPx &&
+            q.y() <= hj - kBorderPx)) {
+        continue;
+      }
+      const double cos_j = std::abs(n.dot((X - Cj).normalized()));
+      if (cos_j < kMinCosAngle) continue;
+      // Visible in j: the pixels around q see the surface at X's depth.
+      const int qc = static_cast<int>(q.x()), qr = static_cast<int>(q.y());
+      const double tolerance = kVisibilityTolerancePx * xj.z() / view_j.fx / std::max(cos_j, 0.2);
+      if (render_j.FaceAt(qr, qc) != f &&
+          !(std::abs(render_j.DepthAt(qr, qc) - xj.z()) <= tolerance)) {
+        continue;
+      }
+      bool visible = true;
+      for (int dr = -kMargin; dr <= kMargin && visible; ++dr) {
+        for (int dc = -kMargin; dc <= kMargin && visible; ++dc) {
+          const int rr = qr + dr, cc = qc + dc;
+          visible = rr >= 0 && cc >= 0 && rr < hj && cc < wj && render_j.FaceAt(rr, cc) >= 0 &&
+                    std::abs(render_j.DepthAt(rr, cc) - xj.z()) <= 3 * tolerance;
+        }
+      }
+      if (!visible) continue;
+      Eigen::Vector2d grad;
+      SampleBilinear(image_j, q.x(), q.y(), &grad);
+      const double score = grad.norm();
+      if (!(score >= kMinGradient)) continue;
+      PhotometricSample s;
+      s.point = Eigen::Vector2d(c + 0.5, r + 0.5);
+      s.normal = n;
+      s.plane_offset = offset;
+      s.intensity = image_i.at<float>(r, c);
+      s.score = score;
+      candidates.push_back(s);
+    }
+  }
+  if (static_cast<int>(candidates.size()) <= max_samples) return candidates;
+
+  // Spread: cells of s x s pixels with s ~ 2 sqrt(candidates / max_samples)
+  // (about 4 samples per cell for a dense region); each cell's best first,
+  // then each cell's second best, ...; within a round, the strongest first.
+  const int cell = std::max(
+      1, static_cast<int>(2.0 * std::sqrt(static_cast<double>(candidates.size()) / max_samples)));
+  const int cells_x = (wi + cell - 1) / cell;
+  std::stable_sort(
+      candidates.begin(), candidates.end(),
+      [](const PhotometricSample& a, const PhotometricSample& b) { return a.score > b.score; });
+  std::unordered_map<int, int> taken;
+  std::vector<std::pair<int, int>> order;  // (rank in its cell, index by score)
+  order.reserve(candidates.size());
+  for (size_t k = 0; k < candidates.size(); ++k) {
+    const int key = static_cast<int>(candidates[k].point.y() / cell) * cells_x +
+                    static_cast<int>(candidates[k].point.x() / cell);
+    order.emplace_back(taken[key]++, static_cast<int>(k));
+  }
+  std::sort(order.begin(), order.end());
+  std::vector<PhotometricSample> selected;
+  selected.reserve(max_samples);
+  for (int k = 0; k < max_samples; ++k) selected.push_back(candidates[order[k].second]);
+  return selected;
+}
+
+}  // namespace internal
+
+bool CameraRefinementOptions::Check() const {
+  if (mode != "poses" && mode != "poses_intrinsics") {
+    MR_THROW_INPUT << "CameraRefinementOptions::mode = " << mode
+                   << ". Violated constraint: mode is poses or poses_intrinsics";
+  }
+  if (max_samples_per_pair < 1) {
+    MR_THROW_INPUT << "CameraRefinementOptions::max_samples_per_pair = " << max_samples_per_pair
+                   << ". Violated constraint: max_samples_per_pair >= 1";
+  }
+  const auto positive = [](const char* name, double value) {
+    if (!(value > 0 && std::isfinite(value))) {
+      MR_THROW_INPUT << "CameraRefinementOptions::" << name << " = " << value
+                     << ". Violated constraint: 0 < " << name << " < inf";
+    }
+  };
+  positive("intensity_sigma", intensity_sigma);
+  positive("huber_delta", huber_delta);
+  positive("prior_rotation_deg", prior_rotation_deg);
+  positive("prior_center_px", prior_center_px);
+  positive("prior_focal_percent", prior_focal_percent);
+  if (max_iterations < 1) {
+    MR_THROW_INPUT << "CameraRefinementOptions::max_iterations = " << max_iterations
+                   << ". Violated constraint: max_iterations >= 1";
+  }
+  return true;
+}
+
+namespace {
+
+constexpr double kDegree = M_PI / 180.0;
+
+double MaxOf(const std::vector<double>& values) {
+  double m = 0;
+  for (double v : values) m = std::max(m, v);
+  return m;
+}
+
+// Median of depth / fx over the pixels that see the mesh; 0 if none.
+double MedianFootprint(const PinholeView& view, const RenderBuffers& render) {
+  std::vector<float> depths;
+  for (size_t k = 0; k < render.face_id.size(); ++k) {
+    if (render.face_id[k] >= 0) depths.push_back(render.depth[k]);
+  }
+  if (depths.empty()) return 0;
+  std::nth_element(depths.begin(), depths.begin() + depths.size() / 2, depths.end());
+  return depths[depths.size() / 2] / view.fx;
+}
+
+void CheckInputs(const std::vector<cv::Mat>& gray_images,
+                 const std::vector<std::pair<int, int>>& pairs, const Eigen::MatrixXd& V,
+                 const Eigen::MatrixXi& F, const std::vector<int>& camera_of_view,
+                 const std::vector<PinholeView>& views) {
+  const int num_views = static_cast<int>(views.size());
+  if (static_cast<int>(gray_images.size()) != num_views) {
+    MR_THROW_INPUT << "RefineCameras: " << gray_images.size() << " images for " << num_views
+                   << " views; expected one image per view";
+  }
+  for (int i = 0; i < num_views; ++i) {
+    const cv::Mat& image = gray_images[i];
+    if (image.type() != CV_32F || image.cols != views[i].width || image.rows != views[i].height) {
+      MR_THROW_INPUT << "RefineCameras: image " << i << " is " << image.cols << "x" << image.rows
+                     << " of OpenCV type " << image.type() << "; expected CV_32F (type " << CV_32F
+                     << ") at the view's " << views[i].width << "x" << views[i].height;
+    }
+  }
+  for (const auto& [i, j] : pairs) {
+    if (i < 0 || j < 0 || i >= num_views || j >= num_views || i == j) {
+      MR_THROW_INPUT << "RefineCameras: pair (" << i << ", " << j
+                     << ") is not two distinct views among " << num_views;
+    }
+  }
+  if (V.cols() != 3 || F.cols() != 3 || F.rows() == 0) {
+    MR_THROW_INPUT << "RefineCameras: mesh is " << V.rows() << "x" << V.cols() << " vertices, "
+                   << F.rows() << "x" << F.cols() << " faces; expected #V by 3 and #F by 3, #F > 0";
+  }
+  if (!camera_of_view.empty() && static_cast<int>(camera_of_view.size()) != num_views) {
+    MR_THROW_INPUT << "RefineCameras: camera_of_view has " << camera_of_view.size()
+                   << " entries for " << num_views << " views; expected one per view or none";
+  }
+}
+
+// The parameter blocks of the problem (their addresses must not move).
+struct CameraParameters {
+  std::vector<std::array<double, 9>> rotation;  // per view, row-major cam_from_world
+  std::vector<std::array<double, 3>> center;    // per view
+  // Intrinsics (fx, fy, cx, cy): one block per camera (poses_intrinsics) or
+  // per view (poses, held constant), and the camera id of each block.
+  std::vector<std::array<double, 4>> intrinsics;
+  std::vector<int> block_of_view;
+  std::vector<int> camera_of_block;
+  std::vector<std::array<double, 2>> brightness;  // per ordered pair: a, b
+};
+
+// Rotations, centres and intrinsics blocks from the views; throws InputError
+// if views of one camera start with different intrinsics.
+CameraParameters InitialParameters(const std::vector<PinholeView>& views,
+                                   const std::vector<int>& camera_of_view, bool per_camera) {
+  const int num_views = static_cast<int>(views.size());
+  CameraParameters p;
+  p.rotation.resize(num_views);
+  p.center.resize(num_views);
+  p.block_of_view.resize(num_views);
+  std::map<int, int> block_of_camera;
+  std::vector<int> first_view_of_block;
+  for (int i = 0; i < num_views; ++i) {
+    const PinholeView& v = views[i];
+    Eigen::Map<internal::RowMatrix3d>(p.rotation[i].data()) = v.R;
+    Eigen::Map<Eigen::Vector3d>(p.center[i].data()) = v.Center();
+    const int camera = camera_of_view.empty() ? i : camera_of_view[i];
+    const std::array<double, 4> k = {v.fx, v.fy, v.cx, v.cy};
+    const auto [it, inserted] =
+        block_of_camera.emplace(per_camera ? camera : i, static_cast<int>(p.intrinsics.size()));
+    p.block_of_view[i] = it->second;
+    if (inserted) {
+      p.intrinsics.push_back(k);
+      p.camera_of_block.push_back(camera);
+      first_view_of_block.push_back(i);
+      continue;
+    }
+    const std::array<double, 4>& first = p.intrinsics[it->second];
+    for (int e = 0; e < 4; ++e) {
+      if (std::abs(first[e] - k[e]) > 1e-9 * std::max(1.0, std::abs(k[e]))) {
+        MR_THROW_INPUT << "RefineCameras: views " << first_view_of_block[it->second] << " and " << i
+                       << " share camera " << camera
+                       << " but have different intrinsics (fx, fy, cx, cy)";
+      }
+    }
+  }
+  return p;
+}
+
+struct OrderedPair {
+  int i = 0, j = 0;
+  std::vector<internal::PhotometricSample> samples;
+};
+
+// Renders the views in `pairs` through the mesh (footprints into
+// `footprint`) and picks the samples of both orders of every pair; ordered
+// pairs without samples are left out.
+std::vector<OrderedPair> CollectSamples(const std::vector<cv::Mat>& gray_images,
+                                        const std::vector<std::pair<int, int>>& pairs,
+                                        const Eigen::MatrixXd& V, const Eigen::MatrixXi& F,
+                                        Renderer* renderer, const std::vector<PinholeView>& views,
+                                        int max_samples, std::vector<double>* footprint) {
+  const int num_views = static_cast<int>(views.size());
+  std::vector<char> involved(num_views, 0);
+  for (const auto& [i, j] : pairs) involved[i] = involved[j] = 1;
+  renderer->SetMesh(V, F);
+  std::vector<RenderBuffers> renders(num_views);
+  for (int i = 0; i < num_views; ++i) {
+    if (!involved[i]) continue;
+    renders[i] = renderer->Render(views[i]);
+    (*footprint)[i] = MedianFootprint(views[i], renders[i]);
+  }
+  const Eigen::MatrixXd N = FaceNormals(V, F);
+  std::vector<OrderedPair> ordered;
+  for (const auto& [a, b] : pairs) {
+    for (const auto& [i, j] : {std::make_pair(a, b), std::make_pair(b, a)}) {
+      OrderedPair pair;
+      pair.i = i;
+      pair.j = j;
+      pair.samples = internal::SelectSamples(V, F, N, views[i], renders[i], gray_images[i],
+                                             views[j], renders[j], gray_images[j], max_samples);
+      if (!pair.samples.empty()) ordered.push_back(std::move(pair));
+    }
+  }
+  return ordered;
+}
+
+// The least-squares problem over `params` (which it points into): the
+// photometric residuals of every sample and the priors of every view (and
+// camera) they involve. `refined` receives which views take part.
+void BuildProblem(const std::vector<cv::Mat>& gray_images, const std::vector<OrderedPair>& ordered,
+                  const std::vector<double>& footprint, const CameraRefinementOptions& options,
+                  CameraParameters* params, ceres::Problem* problem,
+                  ceres::ParameterBlockOrdering* ordering, std::vector<char>* refined) {
+  CameraParameters& p = *params;
+  // Huber on r with threshold huber_delta, weighed as residuals of std dev
+  // intensity_sigma: ρ(r²) / σ².
+  ceres::LossFunction* loss = new ceres::ScaledLoss(
+      new ceres::HuberLoss(options.huber_delta),
+      1.0 / (options.intensity_sigma * options.intensity_sigma), ceres::TAKE_OWNERSHIP);
+  p.brightness.assign(ordered.size(), {1.0, 0.0});
+  for (size_t k = 0; k < ordered.size(); ++k) {
+    const int i = ordered[k].i, j = ordered[k].j;
+    const int bi = p.block_of_view[i], bj = p.block_of_view[j];
+    for (const auto& sample : ordered[k].samples) {
+      if (bi == bj) {
+        problem->AddResidualBlock(internal::NewPhotometricCost(sample, gray_images[j], true), loss,
+                                  p.rotation[i].data(), p.center[i].data(), p.rotation[j].data(),
+                                  p.center[j].data(), p.intrinsics[bi].data(),
+                                  p.brightness[k].data());
+      } else {
+        problem->AddResidualBlock(internal::NewPhotometricCost(sample, gray_images[j], false), loss,
+                                  p.rotation[i].data(), p.center[i].data(), p.intrinsics[bi].data(),
+                                  p.rotation[j].data(), p.center[j].data(), p.intrinsics[bj].data(),
+                                  p.brightness[k].data());
+      }
+    }
+    (*refined)[i] = (*refined)[j] = 1;
+    // The brightness blocks never share a residual: Schur eliminates them.
+    ordering->AddElementToGroup(p.brightness[k].data(), 0);
+  }
+
+  ceres::Manifold* manifold = internal::NewRotationMatrixManifold();
+  for (size_t i = 0; i < refined->size(); ++i) {
+    if (!(*refined)[i]) continue;
+    const Eigen::Matrix3d R0 = Eigen::Map<const internal::RowMatrix3d>(p.rotation[i].data());
+    const Eigen::Vector3d C0 = Eigen::Map<const Eigen::Vector3d>(p.center[i].data());
+    problem->SetManifold(p.rotation[i].data(), manifold);
+    problem->AddResidualBlock(
+        new ceres::AutoDiffCostFunction<internal::RotationPrior, 3, 9>(
+            new internal::RotationPrior(R0, options.prior_rotation_deg * kDegree)),
+        nullptr, p.rotation[i].data());
+    MR_CHECK_GT(footprint[i], 0);
+    problem->AddResidualBlock(
+        new ceres::AutoDiffCostFunction<internal::CenterPrior, 3, 3>(
+            new internal::CenterPrior(C0, options.prior_center_px * footprint[i])),
+        nullptr, p.center[i].data());
+    ordering->AddElementToGroup(p.rotation[i].data(), 1);
+    ordering->AddElementToGroup(p.center[i].data(), 1);
+  }
+  for (auto& k : p.intrinsics) {
+    if (!problem->HasParameterBlock(k.data())) continue;
+    ordering->AddElementToGroup(k.data(), 1);
+    if (options.mode != "poses_intrinsics") {
+      problem->SetParameterBlockConstant(k.data());
+      continue;
+    }
+    problem->AddResidualBlock(
+        new ceres::AutoDiffCostFunction<internal::FocalPrior, 2, 4>(
+            new internal::FocalPrior(k[0], k[1], options.prior_focal_percent / 100.0)),
+        nullptr, k.data());
+  }
+}
+
+// Writes the solution into `views` and the changes into `summary`.
+void WriteBack(const CameraParameters& p, const std::vector<char>& refined, bool intrinsics,
+               std::vector<PinholeView>* views, CameraRefinementSummary* summary) {
+  for (size_t i = 0; i < views->size(); ++i) {
+    PinholeView& view = (*views)[i];
+    if (refined[i]) {
+      const Eigen::Matrix3d R = Eigen::Map<const internal::RowMatrix3d>(p.rotation[i].data());
+      const Eigen::Vector3d C = Eigen::Map<const Eigen::Vector3d>(p.center[i].data());
+      summary->rotation_change_deg[i] =
+          internal::LogRotation(R * view.R.transpose()).norm() / kDegree;
+      summary->center_change[i] = (C - view.Center()).norm();
+      summary->center_change_px[i] = summary->center_change[i] / summary->footprint[i];
+      view.R = R;
+      view.t = -R * C;
+    }
+    if (!intrinsics) continue;
+    const std::array<double, 4>& k = p.intrinsics[p.block_of_view[i]];
+    const int camera = p.camera_of_block[p.block_of_view[i]];
+    if (summary->focal_change_percent.count(camera) == 0) {
+      summary->focal_change_percent[camera] = 100.0 * ((k[0] + k[1]) / (view.fx + view.fy) - 1.0);
+      summary->principal_point_change_px[camera] = std::hypot(k[2] - view.cx, k[3] - view.cy);
+    }
+    view.fx = k[0];
+    view.fy = k[1];
+    view.cx = k[2];
+    view.cy = k[3];
+  }
+}
+
+}  // namespace
+
+CameraRefinementSummary RefineCameras(const std::vector<cv::Mat>& gray_images,
+                                      const std::vector<std::pair<int, int>>& pairs,
+                                      const Eigen::MatrixXd& V, const Eigen::MatrixXi& F,
+                                      Renderer* renderer, const std::vector<int>& camera_of_view,
+                                      const CameraRefinementOptions& options,
+                                      std::vector<PinholeView>* views) {
+  options.Check();
+  MR_CHECK(views != nullptr && renderer != nullptr);
+  CheckInputs(gray_images, pairs, V, F, camera_of_view, *views);
+  const double start_s = ElapsedSeconds();
+  const int num_views = static_cast<int>(views->size());
+  const bool intrinsics = options.mode == "poses_intrinsics";
+  CameraRefinementSummary summary;
+  summary.mode = options.mode;
+  summary.rotation_change_deg.assign(num_views, 0.0);
+  summary.center_change.assign(num_views, 0.0);
+  summary.center_change_px.assign(num_views, 0.0);
+  summary.footprint.assign(num_views, 0.0);
+
+  CameraParameters params = InitialParameters(*views, camera_of_view, intrinsics);
+  const std::vector<OrderedPair> ordered = CollectSamples(
+      gray_images, pairs, V, F, renderer, *views, options.max_samples_per_pair, &summary.footprint);
+  summary.num_ordered_pairs = static_cast<int>(ordered.size());
+  for (const OrderedPair& pair : ordered) summary.num_samples += pair.samples.size();
+  if (ordered.empty()) {
+    MR_LOG(WARNING) << "Camera refinement: no view pair shares a visible textured surface; "
+                       "cameras left as they are";
+    summary.seconds = ElapsedSeconds() - start_s;
+    return summary;
+  }
+
+  ceres::Problem problem;
+  auto ordering = std::make_shared<ceres::ParameterBlockOrdering>();
+  std::vector<char> refined(num_views, 0);
+  BuildProblem(gray_images, ordered, summary.footprint, options, &params, &problem, ordering.get(),
+               &refined);
+  summary.num_views_refined = static_cast<int>(std::count(refined.begin(), refined.end(), 1));
+
+  ceres::Solver::Options solver;
+  // After eliminating the brightness blocks: 6 parameters per view (+ 4 per
+  // camera), dense up to a few hundred views.
+  solver.linear_solver_type =
+      num_views <= 200 || !ceres::IsSparseLinearAlgebraLibraryTypeAvailable(ceres::SUITE_SPARSE)
+          ? ceres::DENSE_SCHUR
+          : ceres::SPARSE_SCHUR;
+  solver.linear_solver_ordering = ordering;
+  solver.max_num_iterations = options.max_iterations;
+  solver.num_threads = 1;
+  solver.logging_type = ceres::SILENT;
+  ceres::Solver::Summary ceres_summary;
+  ceres::Solve(solver, &problem, &ceres_summary);
+
+  summary.initial_cost = ceres_summary.initial_cost;
+  summary.final_cost = ceres_summary.final_cost;
+  summary.iterations = static_cast<int>(ceres_summary.iterations.size());
+  summary.converged = ceres_summary.termination_type == ceres::CONVERGENCE;
+  summary.ceres_brief_report = ceres_summary.BriefReport();
+  summary.ceres_full_report = ceres_summary.FullReport();
+  if (!ceres_summary.IsSolutionUsable()) {
+    MR_LOG(WARNING) << "Camera refinement failed; cameras left as they are: "
+                    << summary.ceres_brief_report;
+    summary.seconds = ElapsedSeconds() - start_s;
+    return summary;
+  }
+  WriteBack(params, refined, intrinsics, views, &summary);
+  summary.seconds = ElapsedSeconds() - start_s;
+
+  for (int i = 0; i < num_views; ++i) {
+    if (!refined[i]) continue;
+    MR_LOG(VERBOSE) << "Camera refinement: view " << i << ": rotation "
+                    << summary.rotation_change_deg[i] << " deg, centre " << summary.center_change[i]
+                    << " (" << summary.center_change_px[i] << " px footprints)";
+  }
+  for (const auto& [camera, percent] : summary.focal_change_percent) {
+    MR_LOG(VERBOSE) << "Camera refinement: camera " << camera << ": focal " << percent
+                    << " %, principal point " << summary.principal_point_change_px.at(camera)
+                    << " px";
+  }
+  MR_LOG(INFO) << summary.BriefReport();
+  return summary;
+}
+
+std::string CameraRefinementSummary::BriefReport() const {
+  std::ostringstream out;
+  out << "Camera refinement (" << mode << "): " << num_views_refined << " views, "
+      << num_ordered_pairs << " ordered pairs, " << num_samples << " samples; cost "
+      << std::setprecision(4) << initial_cost << " -> " << final_cost << " in " << iterations
+      << " iterations" << (converged ? "" : " (not converged)") << "; largest change: rotation "
+      << std::setprecision(3) << MaxOf(rotation_change_deg) << " deg, centre "
+      << MaxOf(center_change_px) << " px footprints";
+  if (!focal_change_percent.empty()) {
+    double focal = 0;
+    for (const auto& [camera, percent] : focal_change_percent) {
+      focal = std::max(focal, std::abs(percent));
+    }
+    out << ", focal " << focal << " %";
+  }
+  out << "; " << std::setprecision(3) << seconds << " s";
+  return out.str();
+}
+
+std::string CameraRefinementSummary::FullReport() const {
+  std::ostringstream out;
+  out << BriefReport() << "\n";
+  out << "  view  rotation_deg  centre  centre_px  footprint\n";
+  for (size_t i = 0; i < rotation_change_deg.size(); ++i) {
+    if (footprint[i] == 0) continue;
+    out << "  " << std::setw(4) << i << "  " << std::setprecision(4) << std::setw(12)
+        << rotation_change_deg[i] << "  " << std::setw(6) << center_change[i] << "  "
+        << std::setw(9) << center_change_px[i] << "  " << footprint[i] << "\n";
+  }
+  for (const auto& [camera, percent] : focal_change_percent) {
+    out << "  camera " << camera << ": focal " << percent << " %, principal point "
+        << principal_point_change_px.at(camera) << " px\n";
+  }
+  out << ceres_full_report;
+  return out.str();
+}
+
+}  // namespace mr

@@ -1,0 +1,168 @@
+#pragma once
+
+// Photometric refinement of the cameras against a fixed mesh (issue #11).
+//
+// COLMAP's poses carry errors of 0.4-1 px; the surface flow of the refiner
+// then bends the surface to absorb them. Here the mesh is held fixed (it
+// fixes the frame: there is no free gauge) and the cameras move to make the
+// images consistent through it, as a Ceres least-squares problem:
+//
+//   sample p of view i (a pixel centre seeing face f, also seen unoccluded
+//   in view j; strongest image gradient in j first, spread over the image)
+//   X(p)  = C_i + d r_p, the hit of view i's ray r_p = R_iᵀ K_i⁻¹ (p, 1)
+//           with the plane n·X = n·A of face f: d = n·(A - C_i) / (n·r_p)
+//   q     = π_j(X) = K_j (R_j (X - C_j)) projected
+//   r     = I_j(q) - (a_ij I_i(p) + b_ij)          (I_j bilinear)
+//
+// with a per-ordered-pair affine brightness (a_ij, b_ij), under a Huber loss
+// and weighed as residuals of standard deviation intensity_sigma, plus
+// priors that keep each camera near its start (they hold the directions the
+// data barely sees, such as rotations about the centre of a sphere).
+// The photometric Jacobian is analytic (see docs/camera_refinement.md).
+
+#include <Eigen/Core>
+#include <map>
+#include <opencv2/core.hpp>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "geometry/view.h"
+
+namespace ceres {
+class CostFunction;
+class Manifold;
+}  // namespace ceres
+
+namespace mr {
+
+class Renderer;
+struct RenderBuffers;
+
+struct CameraRefinementOptions {
+  // "poses": rotation and centre per view. "poses_intrinsics": also fx, fy,
+  // cx, cy per camera (shared by the views of camera_of_view).
+  std::string mode = "poses";
+  // Pixels sampled per ordered pair (>= 1): highest image gradient first,
+  // spread over the image.
+  int max_samples_per_pair = 3000;
+  // 1-sigma of an intensity residual (images in [0, 1]; > 0): the residuals
+  // are divided by it, so it sets the weight of the images against the
+  // priors. Well above the pixel noise: neighbouring samples are not
+  // independent (they share texture and interpolation stencils), and the
+  // mesh is not exact. Smaller values recover more of a pose error but let
+  // the cameras drift further along directions the images barely see (see
+  // docs/camera_refinement.md for measurements).
+  double intensity_sigma = 0.1;
+  // Huber threshold on the intensity residuals (images in [0, 1]; > 0).
+  double huber_delta = 0.05;
+  // 1-sigma of the prior that keeps each rotation near its start (degrees, > 0).
+  double prior_rotation_deg = 0.2;
+  // 1-sigma of the prior on each camera centre, in pixel footprints of the
+  // view at the mesh (its median depth / fx; > 0).
+  double prior_center_px = 2.0;
+  // 1-sigma of the prior on fx and fy, in percent of the start (> 0;
+  // poses_intrinsics only). The principal point has no prior of its own.
+  double prior_focal_percent = 1.0;
+  // Ceres iterations (>= 1).
+  int max_iterations = 30;
+
+  bool Check() const;
+};
+
+struct CameraRefinementSummary {
+  std::string mode;
+  int num_views_refined = 0;  // views in at least one pair with samples
+  int num_ordered_pairs = 0;  // ordered pairs with samples
+  long num_samples = 0;       // photometric residuals
+  // Ceres's cost (photometric under the Huber loss, plus the priors), before
+  // and after.
+  double initial_cost = 0;
+  double final_cost = 0;
+  // Per view (all views; 0 for views not refined): rotation change (degrees),
+  // centre change (scene units and pixel footprints of the view).
+  std::vector<double> rotation_change_deg;
+  std::vector<double> center_change;
+  std::vector<double> center_change_px;
+  std::vector<double> footprint;  // median pixel footprint of the view (scene units)
+  // Per camera id (poses_intrinsics only): change of the mean focal length
+  // (fx + fy) / 2 in percent, and of the principal point in pixels.
+  std::map<int, double> focal_change_percent;
+  std::map<int, double> principal_point_change_px;
+  int iterations = 0;
+  bool converged = false;
+  std::string ceres_brief_report;
+  std::string ceres_full_report;
+  double seconds = 0;
+
+  // One line: mode, counts, cost before and after, largest changes, time.
+  std::string BriefReport() const;
+  // BriefReport, one line per refined view and camera, and Ceres's report.
+  std::string FullReport() const;
+};
+
+// Refines `views` in place against the fixed mesh (V, F) (#V by 3, #F by 3).
+// `gray_images`: one CV_32F image in [0, 1] per view, at the view's
+// resolution (for a pyramid level, pass its images and PyramidLevelView
+// views, then scale the intrinsics back). `pairs`: view pairs {i, j} (as
+// NeighborPairs gives them), used in both directions. `camera_of_view`: the
+// camera (any int id, e.g. COLMAP's camera_id) of each view; in
+// poses_intrinsics the views of one camera must have equal intrinsics and
+// share one refined set. Empty: one camera per view. `renderer` renders the mesh (its
+// current mesh is replaced). Views in no pair keep their pose (but take their
+// camera's new intrinsics). Samples are picked once, at the start poses.
+// Returns with the cameras unchanged (and a WARNING) if no pair has samples
+// or Ceres finds no usable solution. Throws InputError on bad options or
+// inputs.
+CameraRefinementSummary RefineCameras(const std::vector<cv::Mat>& gray_images,
+                                      const std::vector<std::pair<int, int>>& pairs,
+                                      const Eigen::MatrixXd& V, const Eigen::MatrixXi& F,
+                                      Renderer* renderer, const std::vector<int>& camera_of_view,
+                                      const CameraRefinementOptions& options,
+                                      std::vector<PinholeView>* views);
+
+namespace internal {
+
+// One photometric sample of the ordered pair (i, j): the image point p of
+// view i (a pixel centre), the plane n·X = plane_offset of the face it sees
+// (world frame, unit n) and the intensity I_i(p).
+struct PhotometricSample {
+  Eigen::Vector2d point = Eigen::Vector2d::Zero();
+  Eigen::Vector3d normal = Eigen::Vector3d::UnitZ();
+  double plane_offset = 0;
+  double intensity = 0;
+  double score = 0;  // |∇I_j| at the projection (px⁻¹), what the selection ranks by
+};
+
+// The samples of the ordered pair (i, j) as RefineCameras picks them:
+// pixels of view i inside the surface (their 5x5 neighbourhood sees it),
+// seen within 60 degrees of the face normal in both views, projecting at
+// least 3 px inside image j onto a 5x5 neighbourhood that sees the surface
+// at the point's depth (not occluded), with |∇I_j| >= 1e-3 px⁻¹; at most
+// `max_samples`, highest gradient first, spread over a grid of cells (round
+// robin: every cell's best, then every cell's second best, ...).
+// `face_normals`: #F by 3 unit normals.
+std::vector<PhotometricSample> SelectSamples(const Eigen::MatrixXd& V, const Eigen::MatrixXi& F,
+                                             const Eigen::MatrixXd& face_normals,
+                                             const PinholeView& view_i,
+                                             const RenderBuffers& render_i, const cv::Mat& image_i,
+                                             const PinholeView& view_j,
+                                             const RenderBuffers& render_j, const cv::Mat& image_j,
+                                             int max_samples);
+
+// The photometric residual r = I_j(q) - (a I_i(p) + b) of one sample as a
+// ceres::SizedCostFunction with analytic Jacobians. Parameter blocks, with
+// rotations as row-major 3x3 cam_from_world matrices (9 values, with
+// RotationMatrixManifold) and intrinsics as (fx, fy, cx, cy):
+//   shared_intrinsics = false: R_i (9), C_i (3), K_i (4), R_j (9), C_j (3), K_j (4), (a, b)
+//   shared_intrinsics = true:  R_i (9), C_i (3), R_j (9), C_j (3), K (4), (a, b)
+// `image_j` (CV_32F) must outlive the cost function (its data is shared).
+ceres::CostFunction* NewPhotometricCost(const PhotometricSample& sample, const cv::Mat& image_j,
+                                        bool shared_intrinsics);
+
+// The rotation matrices (row-major, 9 values) with the tangent update
+// Plus(R, δ) = Exp(δ) R (δ an angle-axis vector in the camera frame).
+ceres::Manifold* NewRotationMatrixManifold();
+
+}  // namespace internal
+}  // namespace mr
