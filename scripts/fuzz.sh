@@ -12,7 +12,8 @@
 # Prints per harness: executions, exec/s, libFuzzer's cov: (edges) and ft:
 # (features), the corpus size, findings and seconds. Exits 1 if any harness
 # found a crash, a sanitizer report, a leak, a timeout (-timeout, default
-# 10 s per input) or an out-of-memory (-rss_limit_mb 2048); the input is
+# 10 s per input, TIMEOUT=60 to change; also the slow-unit report's bound) or
+# an out-of-memory (-rss_limit_mb 2048); the input is
 # saved under build-fuzz/artifacts/<harness>/ and the log beside it.
 # New inputs the fuzzer finds go to build-fuzz/corpus/<harness>/ (kept
 # between runs; fuzz/corpus/ holds only the seeds).
@@ -74,6 +75,7 @@ for h in "${harnesses[@]}"; do
   echo "fuzz.sh: $h ${limit[*]} -max_len=${MAX_LEN[$h]} (log: $log)"
   set +e
   "$BUILD/fuzz/fuzz_$h" "${limit[@]}" -max_len="${MAX_LEN[$h]}" -timeout="$TIMEOUT" \
+    -report_slow_units="$TIMEOUT" \
     -rss_limit_mb=2048 -print_final_stats=1 -artifact_prefix="$artifacts/" \
     "$corpus" "fuzz/corpus/$h" >"$log" 2>&1
   rc=$?
