@@ -297,6 +297,10 @@ std::vector<BadInput> Table() {
       {"RefinerMaxImageSizeZero", R, "`--Refine.max_image_size 0`", kNothing,
        kWs + " --Refine.max_image_size 0", 1,
        "RefineOptions::max_image_size = 0. Violated constraint: max_image_size >= 32 or -1"},
+      {"RefinerRefineCamerasUnknown", R, "`--Refine.refine_cameras all`", kNothing,
+       kWs + " --Refine.refine_cameras all", 1,
+       "RefineOptions::refine_cameras = all. Violated constraint: one of none, poses, "
+       "poses_intrinsics"},
       {"RefinerOptionNotANumber", R, "`--Refine.step abc`", kNothing, kWs + " --Refine.step abc",
        1, "--Refine.step abc: expected a finite number"},
       {"RefinerOptionNaN", R, "`--Refine.step nan`", kNothing, kWs + " --Refine.step nan", 1,

@@ -11,6 +11,7 @@
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
+#include <map>
 
 #include <opencv2/imgcodecs.hpp>
 
@@ -457,6 +458,40 @@ TEST_F(MeshRefinerCli, MeshCoveringFewPixelsIsFlagged) {
   EXPECT_NE(r.output.find("WARNING: " + dir_ + "/meshed-poisson.ply covers only"), std::string::npos)
       << r.output;
   EXPECT_NE(r.output.find("(expected at least 1 %)"), std::string::npos) << r.output;
+}
+
+// --Refine.refine_cameras: the refined model goes to <workspace>/sparse_refined
+// with the same ids; sparse/ is left byte-identical. The test workspace's
+// cameras are exact, so they barely move.
+TEST_F(MeshRefinerCli, RefinedCamerasAreWrittenBesideTheModel) {
+  std::map<std::string, std::string> sparse_before;
+  for (const auto& name : ListFiles(dir_ + "/sparse")) {
+    sparse_before[name] = ReadFileToString(dir_ + "/sparse/" + name);
+  }
+  const CommandResult r = RunCommand(kRefiner + " --workspace_path " + dir_ + kFast +
+                                     " --Refine.refine_cameras poses");
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  EXPECT_NE(r.output.find("Level 0 cameras: Camera refinement (poses)"), std::string::npos)
+      << r.output;
+  EXPECT_NE(r.output.find("Wrote the refined cameras to " + dir_ + "/sparse_refined"),
+            std::string::npos)
+      << r.output;
+  for (const auto& [name, bytes] : sparse_before) {
+    EXPECT_EQ(ReadFileToString(dir_ + "/sparse/" + name), bytes) << name;
+  }
+  const Reconstruction before = ReadSparseModel(dir_ + "/sparse");
+  const Reconstruction after = ReadSparseModel(dir_ + "/sparse_refined");
+  ASSERT_EQ(after.images.size(), before.images.size());
+  EXPECT_EQ(after.points3D.size(), before.points3D.size());
+  double largest_move = 0;
+  for (const auto& [id, image] : before.images) {
+    ASSERT_TRUE(after.images.count(id));
+    EXPECT_EQ(after.images.at(id).name, image.name);
+    largest_move = std::max(largest_move, (after.images.at(id).ProjectionCenter() -
+                                           image.ProjectionCenter()).norm());
+  }
+  EXPECT_GT(largest_move, 0.0);   // refined, so not bit-identical
+  EXPECT_LT(largest_move, 0.05);  // exact cameras stay put (scene radius 1, distance 4)
 }
 
 TEST_F(MeshRefinerCli, BadOptionNamesTheField) {

@@ -13,6 +13,7 @@
 
 #include "colmap_io/mesh_io.h"
 #include "colmap_io/ply.h"
+#include "colmap_io/sparse_model.h"
 #include "colmap_io/workspace.h"
 #include "geometry/mesh.h"
 #include "refine/refiner.h"
@@ -53,6 +54,30 @@ void WarnIfMeaningless(const RefineSummary& summary) {
                   << ": the images do not agree with each other through the mesh, so the result "
                      "is probably meaningless. Check the cameras (distortion parameters), that "
                      "the mesh belongs to these images, and --Refine.num_levels";
+}
+
+// The workspace's model with the refined cameras of `source`'s views (same
+// ids; intrinsics of a camera from its first view; SIMPLE_PINHOLE gets the
+// mean of fx and fy), written in COLMAP's binary format to `path`.
+void WriteRefinedModel(const Workspace& workspace, const WorkspaceViewSource& source,
+                       const std::vector<PinholeView>& cameras, const std::string& path) {
+  Reconstruction model = workspace.model;
+  std::set<uint32_t> cameras_done;
+  for (int i = 0; i < source.NumViews(); ++i) {
+    const PinholeView& view = cameras.at(i);
+    Image& image = model.images.at(source.ImageId(i));
+    image.qvec = RotationToQuaternion(view.R);
+    image.tvec = view.t;
+    if (!cameras_done.insert(image.camera_id).second) continue;
+    Camera& camera = model.cameras.at(image.camera_id);
+    if (camera.model == CameraModel::kSimplePinhole) {
+      camera.params = {0.5 * (view.fx + view.fy), view.cx, view.cy};
+    } else {
+      camera.params = {view.fx, view.fy, view.cx, view.cy};
+    }
+  }
+  CreateDirIfNotExists(path);
+  WriteSparseModelBinary(path, model);
 }
 
 // Prints the dry-run summary of a workspace and mesh.
@@ -159,6 +184,13 @@ int Run(int argc, char** argv) {
   }
   RefuseOutputOverInput("--output_path", output_path, {input_path});
   if (ExistsDir(input_path)) MR_THROW_INPUT << input_path << ": is a folder; expected a PLY mesh";
+  // Camera refinement writes the refined model next to the mesh, never over sparse/.
+  const std::string refined_model_path = JoinPaths(workspace.root, "sparse_refined");
+  if (refine.refine_cameras != "none") {
+    RefuseOutputOverInput("the refined model", refined_model_path,
+                          {workspace.sparse_dir, input_path, output_path});
+    CheckOutputFolder("the refined model", refined_model_path);
+  }
 
   const std::set<std::string> holdout =
       holdout_path.empty() ? std::set<std::string>{} : [&] {
@@ -220,6 +252,12 @@ int Run(int argc, char** argv) {
   const RefineSummary summary = RefineMesh(source, refine, &mesh, &renderer);
   WriteMesh(output_path, mesh);
   MR_LOG(INFO) << "Wrote " << output_path;
+  if (!summary.cameras.empty()) {
+    WriteRefinedModel(workspace, source, summary.cameras, refined_model_path);
+    MR_LOG(INFO) << "Wrote the refined cameras to " << refined_model_path << " ("
+                 << summary.cameras.size() << " images"
+                 << (holdout.empty() ? "" : "; held-out images keep their poses") << ")";
+  }
   std::cout << summary.FullReport();
   WarnIfMeaningless(summary);
   if (!holdout_views.empty()) {

@@ -66,12 +66,49 @@ class RenderCache {
   std::list<std::pair<int, std::shared_ptr<const RenderBuffers>>> entries_;
 };
 
-std::vector<PinholeView> ScaledViews(const ViewSource& source, int level) {
+std::vector<PinholeView> LevelViews(const std::vector<PinholeView>& cameras, int level) {
   std::vector<PinholeView> views;
-  for (int i = 0; i < source.NumViews(); ++i) {
-    views.push_back(PyramidLevelView(source.View(i), level));
-  }
+  for (const PinholeView& camera : cameras) views.push_back(PyramidLevelView(camera, level));
   return views;
+}
+
+// refine_cameras: refines the level's views against the current mesh and
+// carries the result to the working-resolution cameras (a level's intrinsics
+// are the full ones times 2^-level exactly, PyramidLevelView).
+void RefineCamerasAtLevel(const RefineOptions& options,
+                          const std::vector<std::pair<int, int>>& pairs, const Eigen::MatrixXd& V,
+                          const Eigen::MatrixXi& F, int level,
+                          const std::vector<int>& camera_of_view, Renderer* renderer,
+                          size_t max_bytes, ImageCache* images, std::vector<PinholeView>* views,
+                          std::vector<PinholeView>* cameras, RefineSummary* summary) {
+  size_t bytes = 0;
+  for (const PinholeView& view : *views) bytes += size_t(view.width) * view.height * sizeof(float);
+  if (bytes > max_bytes) {
+    MR_LOG(INFO) << "Cameras not refined at level " << level << ": its images take "
+                 << (bytes >> 20) << " MiB, more than " << (max_bytes >> 20)
+                 << " MiB (half of --Refine.cache_mb)";
+    return;
+  }
+  std::vector<cv::Mat> gray;
+  for (int i = 0; i < static_cast<int>(views->size()); ++i) gray.push_back(images->Gray(i, level));
+  CameraRefinementOptions camera_options = options.camera_refinement;
+  camera_options.mode = options.refine_cameras;
+  const CameraRefinementSummary refined =
+      RefineCameras(gray, pairs, V, F, renderer, camera_of_view, camera_options, views);
+  MR_LOG(INFO) << "Level " << level << " cameras: " << refined.BriefReport();
+  MR_LOG(VERBOSE) << refined.FullReport();
+  summary->camera_reports.push_back("level " + std::to_string(level) + ": " + refined.BriefReport());
+  const double scale = std::ldexp(1.0, level);
+  for (size_t i = 0; i < views->size(); ++i) {
+    PinholeView& camera = (*cameras)[i];
+    const PinholeView& view = (*views)[i];
+    camera.R = view.R;
+    camera.t = view.t;
+    camera.fx = view.fx * scale;
+    camera.fy = view.fy * scale;
+    camera.cx = view.cx * scale;
+    camera.cy = view.cy * scale;
+  }
 }
 
 // Remeshes to the level's target edge length, within the face budget.
@@ -135,13 +172,12 @@ DataTerm ComputeDataTerm(const MeshGeometry& mesh, const std::vector<PinholeView
 }
 
 // Mean plain-ZNCC similarity of all pairs at full resolution through (V, F).
-double FullResolutionSimilarity(const ViewSource& source,
+double FullResolutionSimilarity(const std::vector<PinholeView>& views,
                                 const std::vector<std::pair<int, int>>& pairs,
                                 const SimilarityOptions& similarity,
                                 const PairTermOptions& pair_options, const Eigen::MatrixXd& V,
                                 const Eigen::MatrixXi& F, Renderer* renderer, size_t cache_bytes,
                                 ImageCache* images) {
-  const std::vector<PinholeView> views = source.Views();
   RenderCache renders(renderer, views, cache_bytes);
   renderer->SetMesh(V, F);
   MeshGeometry geometry{&V, &F, FaceNormals(V, F)};
@@ -154,15 +190,15 @@ double FullResolutionSimilarity(const ViewSource& source,
 
 // Per-vertex colours: the mean colour of each vertex over the views where
 // it is visible, weighted by the cosine of the viewing angle.
-void SampleVertexColors(const ViewSource& source, const Eigen::MatrixXd& V,
-                        const Eigen::MatrixXi& F, Renderer* renderer,
+void SampleVertexColors(const ViewSource& source, const std::vector<PinholeView>& views,
+                        const Eigen::MatrixXd& V, const Eigen::MatrixXi& F, Renderer* renderer,
                         Eigen::Matrix<uint8_t, Eigen::Dynamic, 3>* colors) {
   const Eigen::MatrixXd N = VertexNormals(V, F);
   Eigen::MatrixXd sum = Eigen::MatrixXd::Zero(V.rows(), 3);
   Eigen::VectorXd weight = Eigen::VectorXd::Zero(V.rows());
   renderer->SetMesh(V, F);
   for (int i = 0; i < source.NumViews(); ++i) {
-    const PinholeView& view = source.View(i);
+    const PinholeView& view = views[i];
     const RenderBuffers render = renderer->Render(view);
     const cv::Mat color = source.LoadColor(i);
     for (int v = 0; v < V.rows(); ++v) {
@@ -322,6 +358,14 @@ bool RefineOptions::Check() const {
   if (similarity != "dcv" && similarity != "zncc") fail("similarity", similarity, "one of dcv, zncc");
   if (color != "luminance" && color != "principal") fail("color", color, "one of luminance, principal");
   if (!(kappa >= 0)) fail("kappa", std::to_string(kappa), "kappa >= 0");
+  if (refine_cameras != "none" && refine_cameras != "poses" && refine_cameras != "poses_intrinsics") {
+    fail("refine_cameras", refine_cameras, "one of none, poses, poses_intrinsics");
+  }
+  if (refine_cameras != "none") {
+    CameraRefinementOptions cameras = camera_refinement;
+    cameras.mode = refine_cameras;
+    cameras.Check();
+  }
   if (regularizer != "lp" && regularizer != "laplacian" && regularizer != "bilateral_normal" &&
       regularizer != "none") {
     fail("regularizer", regularizer, "one of lp, laplacian, bilateral_normal, none");
@@ -427,6 +471,10 @@ RefineSummary RefineMesh(const ViewSource& input_source, const RefineOptions& op
   }
   MR_LOG(INFO) << "Selected " << pairs.size() << " view pairs among " << source.NumViews()
                << " views";
+  // The cameras at the working resolution; refine_cameras moves them.
+  std::vector<PinholeView> cameras = full_views;
+  std::vector<int> camera_of_view;
+  for (int i = 0; i < source.NumViews(); ++i) camera_of_view.push_back(source.CameraId(i));
 
   const int max_faces = options.FaceBudget(summary.initial_faces);
   const size_t cache_bytes = static_cast<size_t>(options.cache_mb) << 20;
@@ -454,7 +502,7 @@ RefineSummary RefineMesh(const ViewSource& input_source, const RefineOptions& op
   // 0.90; without levels 5-3, at 0.82): such levels are skipped.
   constexpr int kMinLevelFaces = 500;
   while (num_levels > 1) {
-    const int faces = RemeshedFaceCount(ScaledViews(source, num_levels - 1), V, F,
+    const int faces = RemeshedFaceCount(LevelViews(cameras, num_levels - 1), V, F,
                                         options.target_edge_px, max_faces);
     if (faces >= kMinLevelFaces) break;
     MR_LOG(INFO) << "Level " << num_levels - 1 << " skipped: its mesh would have " << faces
@@ -470,7 +518,7 @@ RefineSummary RefineMesh(const ViewSource& input_source, const RefineOptions& op
   const bool initial_from_first_iteration = num_levels == 1 && options.iterations_per_level > 0;
   if (!initial_from_first_iteration) {
     summary.initial_similarity = FullResolutionSimilarity(
-        source, pairs, similarity, options.pair, V, F, renderer, cache_bytes / 2, &images);
+        cameras, pairs, similarity, options.pair, V, F, renderer, cache_bytes / 2, &images);
     MR_LOG(INFO) << "Initial mean similarity (ZNCC, full resolution): "
                  << summary.initial_similarity;
   }
@@ -479,8 +527,12 @@ RefineSummary RefineMesh(const ViewSource& input_source, const RefineOptions& op
   bool guard_verified_clean = false;  // the last iteration's guard found no intersection
   summary.setup_seconds = ElapsedSeconds() - t_start;
   for (int level = num_levels - 1; level >= 0; --level) {
-    const std::vector<PinholeView> views = ScaledViews(source, level);
+    std::vector<PinholeView> views = LevelViews(cameras, level);
     RemeshForLevel(views, options, max_faces, &V, &F);
+    if (options.refine_cameras != "none") {
+      RefineCamerasAtLevel(options, pairs, V, F, level, camera_of_view, renderer, cache_bytes / 2,
+                           &images, &views, &cameras, &summary);
+    }
     double level_seconds = 0;  // of this level's iterations so far, for the ETA
     guard_verified_clean = false;
     // The iterations start from a mesh without self-intersections (what the
@@ -650,7 +702,7 @@ RefineSummary RefineMesh(const ViewSource& input_source, const RefineOptions& op
     MR_LOG(INFO) << "Self-intersections: " << repair.BriefReport();
     summary.self_intersections = static_cast<int>(repair.final_pairs);
   }
-  summary.final_similarity = FullResolutionSimilarity(source, pairs, similarity, options.pair, V, F,
+  summary.final_similarity = FullResolutionSimilarity(cameras, pairs, similarity, options.pair, V, F,
                                                       renderer, cache_bytes / 2, &images);
   const SurfaceDisplacement moved = MeasureSurfaceDisplacement(V, V_input, F_input);
   summary.mean_displacement = moved.mean;
@@ -659,7 +711,23 @@ RefineSummary RefineMesh(const ViewSource& input_source, const RefineOptions& op
   mesh->F = F;
   mesh->N.resize(0, 3);
   mesh->values.resize(0);
-  SampleVertexColors(source, V, F, renderer, &mesh->C);
+  SampleVertexColors(source, cameras, V, F, renderer, &mesh->C);
+  if (options.refine_cameras != "none") {
+    // Back to the resolution of the input source (max_image_size scaled it).
+    for (int i = 0; i < source.NumViews(); ++i) {
+      PinholeView camera = cameras[i];
+      const PinholeView& input = input_source.View(i);
+      const double sx = static_cast<double>(input.width) / source.View(i).width;
+      const double sy = static_cast<double>(input.height) / source.View(i).height;
+      camera.fx *= sx;
+      camera.cx *= sx;
+      camera.fy *= sy;
+      camera.cy *= sy;
+      camera.width = input.width;
+      camera.height = input.height;
+      summary.cameras.push_back(camera);
+    }
+  }
   summary.final_faces = mesh->NumFaces();
   summary.final_vertices = mesh->NumVertices();
   summary.termination = "FINISHED";
@@ -696,6 +764,23 @@ void RegisterRefineOptions(OptionManager* o, RefineOptions* r) {
   o->Add("Refine.regularizer", &r->regularizer,
          "bilateral_normal (normals filtered, vertices fitted), lp (content-aware L_p), laplacian "
          "or none");
+  o->Add("Refine.refine_cameras", &r->refine_cameras,
+         "photometric camera refinement at the start of every level: none, poses, "
+         "poses_intrinsics");
+  o->Add("CameraRefinement.max_samples_per_pair", &r->camera_refinement.max_samples_per_pair,
+         "pixels sampled per ordered view pair (>= 1)");
+  o->Add("CameraRefinement.intensity_sigma", &r->camera_refinement.intensity_sigma,
+         "1-sigma of an intensity residual, images in [0, 1]: the images' weight against the priors");
+  o->Add("CameraRefinement.huber_delta", &r->camera_refinement.huber_delta,
+         "Huber threshold on intensity residuals (> 0)");
+  o->Add("CameraRefinement.prior_rotation_deg", &r->camera_refinement.prior_rotation_deg,
+         "1-sigma of the prior keeping each rotation near its start (degrees)");
+  o->Add("CameraRefinement.prior_center_px", &r->camera_refinement.prior_center_px,
+         "1-sigma of the prior on each camera centre (pixel footprints)");
+  o->Add("CameraRefinement.prior_focal_percent", &r->camera_refinement.prior_focal_percent,
+         "1-sigma of the prior on fx, fy (percent; poses_intrinsics)");
+  o->Add("CameraRefinement.max_iterations", &r->camera_refinement.max_iterations,
+         "Ceres iterations (>= 1)");
   o->Add("Refine.noise_from_step", &r->noise_from_step,
          "lp proximal step: noise estimated from what the gradient step added, not the surface");
   o->Add("Refine.silhouette_weight", &r->silhouette_weight,

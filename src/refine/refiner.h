@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "colmap_io/ply.h"
+#include "refine/camera_refinement.h"
 #include "denoise/denoiser.h"
 #include "refine/photometric.h"
 #include "refine/similarity.h"
@@ -112,6 +113,15 @@ struct RefineOptions {
   // relief off), "laplacian" (1st+2nd order, the isotropic baseline), or
   // "none".
   std::string regularizer = "bilateral_normal";
+  // Photometric refinement of the cameras against the current mesh at the
+  // start of every level, after its remeshing (camera_refinement.h): "none",
+  // "poses" (rotation and centre of every view) or "poses_intrinsics" (also
+  // fx, fy, cx, cy, shared by the views of one camera). The level's images of
+  // all views are held at once for it; a level whose images would take more
+  // than half of cache_mb is not refined (logged). Default "none": not yet
+  // measured on the corpus.
+  std::string refine_cameras = "none";
+  CameraRefinementOptions camera_refinement;  // its mode follows refine_cameras
   // lp proximal step: estimate the noise to remove from what the gradient
   // step added (D applied to the step) instead of from the whole surface,
   // whose relief would count as noise (Denoise's noise_reference).
@@ -183,6 +193,11 @@ struct RefineSummary {
   // similarity and vertex colours.
   double setup_seconds = 0, remesh_seconds = 0, final_seconds = 0;
   std::vector<RefineIteration> iterations;
+  // refine_cameras: the refined cameras of the views (pose and intrinsics at
+  // the resolution of the ViewSource given to RefineMesh), and one report
+  // per refinement; empty when the cameras were not refined.
+  std::vector<PinholeView> cameras;
+  std::vector<std::string> camera_reports;
 
   std::string BriefReport() const;
   std::string FullReport() const;

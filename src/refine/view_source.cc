@@ -66,6 +66,10 @@ cv::Mat WorkspaceViewSource::LoadColor(int i) const {
 
 cv::Mat WorkspaceViewSource::LoadMask(int i) const { return workspace_.ReadMask(ids_.at(i)); }
 
+int WorkspaceViewSource::CameraId(int i) const {
+  return static_cast<int>(workspace_.model.images.at(ids_.at(i)).camera_id);
+}
+
 Eigen::Vector3d PrincipalTextureColor(const ViewSource& source, int max_images,
                                       double sigma_px) {
   Eigen::Matrix3d covariance = Eigen::Matrix3d::Zero();

@@ -33,6 +33,9 @@ class ViewSource {
   // CV_8U mask (nonzero = object) at full resolution, or empty if none.
   virtual cv::Mat LoadMask(int i) const { return {}; }
   virtual bool HasMasks() const { return false; }
+  // The camera (intrinsics) view i shares with others, e.g. COLMAP's
+  // camera_id; by default every view has its own.
+  virtual int CameraId(int i) const { return i; }
 
   std::vector<PinholeView> Views() const;
 };
@@ -50,6 +53,9 @@ class WorkspaceViewSource : public ViewSource {
   cv::Mat LoadColor(int i) const override;
   cv::Mat LoadMask(int i) const override;
   bool HasMasks() const override { return !workspace_.mask_dir.empty(); }
+  int CameraId(int i) const override;
+  // The COLMAP image id of view i.
+  uint32_t ImageId(int i) const { return ids_.at(i); }
 
   // The grey image LoadGray returns: by default the image as COLMAP reads it
   // in grey (OpenCV's luminance). SetGrayWeights(w) makes it the projection
@@ -82,6 +88,7 @@ class ResizedViewSource : public ViewSource {
   cv::Mat LoadColor(int i) const override;
   cv::Mat LoadMask(int i) const override;
   bool HasMasks() const override { return base_.HasMasks(); }
+  int CameraId(int i) const override { return base_.CameraId(i); }
   // Whether view i is scaled down.
   bool Resized(int i) const;
 
