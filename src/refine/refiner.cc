@@ -564,6 +564,14 @@ RefineSummary RefineMesh(const ViewSource& input_source, const RefineOptions& op
                          : 0.0;
       similarity.kappa = record.kappa;
 
+      // The finest level refines the cameras once more halfway, against the
+      // surface its first iterations made (the level's start mesh was fitted
+      // to the old cameras).
+      if (options.refine_cameras != "none" && level == 0 && it > 0 &&
+          it == options.iterations_per_level / 2) {
+        RefineCamerasAtLevel(options, pairs, V, F, level, camera_of_view, renderer,
+                             cache_bytes / 2, &images, &views, &cameras, &summary);
+      }
       const Eigen::MatrixXd V_before = V;
       renderer->SetMesh(V, F);
       renders.Invalidate();
