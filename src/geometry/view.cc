@@ -9,6 +9,19 @@
 
 namespace mr {
 
+PinholeView PinholeView::Resized(int new_width, int new_height) const {
+  PinholeView v = *this;
+  const double sx = static_cast<double>(new_width) / width;
+  const double sy = static_cast<double>(new_height) / height;
+  v.width = new_width;
+  v.height = new_height;
+  v.fx *= sx;
+  v.cx *= sx;
+  v.fy *= sy;
+  v.cy *= sy;
+  return v;
+}
+
 PinholeView PinholeView::Scaled(double scale) const {
   // Continuous image coordinates scale exactly by `scale`; the pixel count
   // rounds up (a half-resolution pyramid level of an odd size n has

@@ -36,6 +36,9 @@ struct PinholeView {
   // Scaled(0.5)); continuous image coordinates scale exactly, the pixel
   // count rounds up.
   PinholeView Scaled(double scale) const;
+  // The same view at `width` x `height` pixels, as COLMAP's Camera::Rescale:
+  // fx, cx scale by the width's ratio, fy, cy by the height's.
+  PinholeView Resized(int width, int height) const;
 };
 
 // A view at `center` looking at `target`, with the image's up direction

@@ -100,14 +100,10 @@ void RefineCamerasAtLevel(const RefineOptions& options,
   summary->camera_reports.push_back("level " + std::to_string(level) + ": " + refined.BriefReport());
   const double scale = std::ldexp(1.0, level);
   for (size_t i = 0; i < views->size(); ++i) {
-    PinholeView& camera = (*cameras)[i];
-    const PinholeView& view = (*views)[i];
-    camera.R = view.R;
-    camera.t = view.t;
-    camera.fx = view.fx * scale;
-    camera.fy = view.fy * scale;
-    camera.cx = view.cx * scale;
-    camera.cy = view.cy * scale;
+    PinholeView full = (*views)[i].Scaled(scale);
+    full.width = (*cameras)[i].width;  // the level's sizes were rounded up
+    full.height = (*cameras)[i].height;
+    (*cameras)[i] = full;
   }
 }
 
@@ -723,17 +719,8 @@ RefineSummary RefineMesh(const ViewSource& input_source, const RefineOptions& op
   if (options.refine_cameras != "none") {
     // Back to the resolution of the input source (max_image_size scaled it).
     for (int i = 0; i < source.NumViews(); ++i) {
-      PinholeView camera = cameras[i];
       const PinholeView& input = input_source.View(i);
-      const double sx = static_cast<double>(input.width) / source.View(i).width;
-      const double sy = static_cast<double>(input.height) / source.View(i).height;
-      camera.fx *= sx;
-      camera.cx *= sx;
-      camera.fy *= sy;
-      camera.cy *= sy;
-      camera.width = input.width;
-      camera.height = input.height;
-      summary.cameras.push_back(camera);
+      summary.cameras.push_back(cameras[i].Resized(input.width, input.height));
     }
   }
   summary.final_faces = mesh->NumFaces();

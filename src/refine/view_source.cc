@@ -179,14 +179,7 @@ ResizedViewSource::ResizedViewSource(const ViewSource& base, int max_image_size)
       const double scale = static_cast<double>(max_image_size) / longest;
       const int width = std::max(1, static_cast<int>(std::lround(view.width * scale)));
       const int height = std::max(1, static_cast<int>(std::lround(view.height * scale)));
-      const double sx = static_cast<double>(width) / view.width;
-      const double sy = static_cast<double>(height) / view.height;
-      view.fx *= sx;
-      view.cx *= sx;
-      view.fy *= sy;
-      view.cy *= sy;
-      view.width = width;
-      view.height = height;
+      view = view.Resized(width, height);
     }
     views_.push_back(view);
   }
