@@ -431,6 +431,21 @@ std::vector<BadInput> Table() {
        kEvaluate + " --workspace_path {dir}/ws --min_views 0", 1, "--min_views 0: expected >= 1"},
       {"EvaluatorWorkspaceMissing", E, "`--workspace_path` that does not exist", kNothing,
        kEvaluate + " --workspace_path {dir}/nope", 1, "workspace folder does not exist"},
+      {"EvaluatorSparsePathAlone", E, "`--sparse_path` without `--true_sparse_path`", kNothing,
+       kEvaluate + " --sparse_path {dir}/ws/sparse", 1,
+       "--sparse_path and --true_sparse_path go together (got only --sparse_path)"},
+      {"EvaluatorTrueSparseMissing", E, "`--true_sparse_path` that does not exist", kNothing,
+       kEvaluate + " --sparse_path {dir}/ws/sparse --true_sparse_path {dir}/nope", 1,
+       "nope: folder does not exist"},
+      {"EvaluatorTrueModelLacksImage", E, "the true model lacks an image of `--sparse_path`",
+       [](const std::string& d) {
+         Reconstruction model = ReadSparseModel(d + "/ws/sparse");
+         model.images.begin()->second.name = "elsewhere.png";
+         fs::create_directories(d + "/other");
+         WriteSparseModelBinary(d + "/other", model);
+       },
+       kEvaluate + " --sparse_path {dir}/ws/sparse --true_sparse_path {dir}/other", 1,
+       ") is not in the true model"},
       {"EvaluatorUnknownOption", E, "an unknown option", kNothing, kEvaluate + " --bogus 1", 1,
        "unknown option 'bogus'"},
       {"EvaluatorWriteConfigOverGroundTruth", E, "`--write_config` is the ground truth", kNothing,

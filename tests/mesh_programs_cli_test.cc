@@ -8,6 +8,7 @@
 
 #include "colmap_io/mesh_io.h"
 #include "colmap_io/ply.h"
+#include "colmap_io/sparse_model.h"
 #include "tests/command.h"
 #include "util/file.h"
 
@@ -119,6 +120,58 @@ TEST_F(MeshProgramsCli, EvaluatorWriteConfigOverInputIsRefused) {
 // The other programs name their inputs too: --write_config is refused over
 // a workspace's model or lists, into a Middlebury data set folder, and over
 // a second mesh. (Refused before the inputs are read, so stand-ins do.)
+// --sparse_path / --true_sparse_path: two PINHOLE cameras (fx 500) 5 units
+// from the ground truth's centre, one of them moved 0.01 units sideways in
+// its own frame. The moved view's ground-truth vertices lie at depths 3.99,
+// 6.01 and 5 (four of them), so they move by 500 * 0.01 / depth pixels: RMS
+// 1.0216 px; over both images sqrt(1.0216^2 / 2) = 0.7224 px.
+TEST_F(MeshProgramsCli, EvaluatorComparesCamerasWithTheTrueOnes) {
+  Reconstruction truth;
+  for (uint32_t id : {1u, 2u}) {
+    Camera camera;
+    camera.camera_id = id;
+    camera.model = CameraModel::kPinhole;
+    camera.width = 640;
+    camera.height = 480;
+    camera.params = {500, 500, 320, 240};
+    truth.cameras[id] = camera;
+    Image image;
+    image.image_id = id;
+    image.camera_id = id;
+    image.name = id == 1 ? "a.png" : "b.png";
+    // a: at (0, 0, -5) looking along +z; b: at (-5, 0, 0) looking along +x.
+    image.qvec = id == 1 ? Eigen::Vector4d(1, 0, 0, 0)
+                         : Eigen::Vector4d(std::sqrt(0.5), 0, -std::sqrt(0.5), 0);
+    image.tvec = Eigen::Vector3d(0, 0, 5);
+    truth.images[id] = image;
+  }
+  Reconstruction moved = truth;
+  moved.images.at(2).tvec.x() += 0.01;
+  for (const auto& [name, model] : {std::make_pair("true", truth), std::make_pair("moved", moved)}) {
+    fs::create_directories(dir_ + "/" + name);
+    WriteSparseModelBinary(dir_ + "/" + name, model);
+  }
+  const std::string evaluate = kEvaluator + " --input_path " + dir_ + "/m.ply --gt_path " + dir_ +
+                               "/gt.ply --num_samples 1000 --true_sparse_path " + dir_ + "/true";
+  const auto number = [](const std::string& json, const std::string& key) {
+    const size_t at = json.find("\"" + key + "\": ");
+    EXPECT_NE(at, std::string::npos) << key << " in " << json;
+    return at == std::string::npos ? -1.0 : std::stod(json.substr(at + key.size() + 4));
+  };
+  const CommandResult same = RunCommand(evaluate + " --sparse_path " + dir_ + "/true");
+  ASSERT_EQ(same.exit_code, 0) << same.output;
+  EXPECT_EQ(number(same.output, "camera_images"), 2);
+  EXPECT_LT(number(same.output, "camera_rms_px"), 1e-9);
+  const CommandResult off = RunCommand(evaluate + " --sparse_path " + dir_ + "/moved");
+  ASSERT_EQ(off.exit_code, 0) << off.output;
+  EXPECT_NEAR(number(off.output, "camera_rms_px"), 0.7224, 1e-3) << off.output;
+  EXPECT_NEAR(number(off.output, "camera_max_rms_px"), 1.0216, 1e-3) << off.output;
+  EXPECT_NE(off.output.find("\"camera_max_rms_image\": \"b.png\""), std::string::npos)
+      << off.output;
+  EXPECT_EQ(number(off.output, "camera_max_focal_percent"), 0);
+  EXPECT_NE(off.output.find("\"accuracy90\": "), std::string::npos) << off.output;
+}
+
 TEST_F(MeshProgramsCli, OtherProgramsWriteConfigOverInputIsRefused) {
   const std::string ws = dir_ + "/ws", cameras = ws + "/sparse/cameras.bin";
   fs::create_directories(ws + "/sparse");

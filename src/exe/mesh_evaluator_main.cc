@@ -3,6 +3,8 @@
 //
 //   mesh_evaluator --input_path meshed-refined.ply --gt_path gt.ply
 //       [--threshold 1.25] [--num_samples 200000] [--seed 1]
+//       [--workspace_path dense/] [--sparse_path dense/sparse_refined
+//        --true_sparse_path sparse_true]
 
 #include <exception>
 #include <iostream>
@@ -10,6 +12,7 @@
 #include <vector>
 
 #include "colmap_io/mesh_io.h"
+#include "colmap_io/sparse_model.h"
 #include "eval/evaluator.h"
 #include "util/error.h"
 #include "util/file.h"
@@ -17,6 +20,7 @@
 #include "util/options.h"
 #include "colmap_io/workspace.h"
 #include "geometry/view.h"
+#include "synth/camera_error.h"
 #include "util/program.h"
 
 int main(int argc, char** argv) {
@@ -27,7 +31,9 @@ int main(int argc, char** argv) {
     mr::OptionManager manager(
         "mesh_evaluator",
         "Evaluates a mesh (.ply/.obj) against a ground-truth mesh and prints one JSON line: "
-        "accuracy90, completeness (%), chamfer, normal_deg, mean_accuracy, faces.");
+        "accuracy90, completeness (%), chamfer, normal_deg, mean_accuracy, faces; with "
+        "--sparse_path and --true_sparse_path also how far the model's cameras are from the true "
+        "ones.");
     manager.AddRequired("input_path", &input_path, "mesh to evaluate (.ply or .obj)");
     manager.AddRequired("gt_path", &gt_path, "ground-truth mesh (.ply or .obj)");
     manager.Add("threshold", &options.threshold,
@@ -41,12 +47,29 @@ int main(int argc, char** argv) {
                 "COLMAP workspace: measure only the ground truth seen by >= min_views of its "
                 "cameras (Middlebury-style observed surface)");
     manager.Add("min_views", &min_views, "with --workspace_path: views that must see a face (>= 1)");
+    std::string sparse_path, true_sparse_path;
+    manager.Add("sparse_path", &sparse_path,
+                "COLMAP model (e.g. sparse_refined/) whose cameras are compared with "
+                "--true_sparse_path: camera_rms_px is the RMS reprojection displacement of the "
+                "ground-truth vertices each true view sees, camera_max_focal_percent the worst "
+                "focal error");
+    manager.Add("true_sparse_path", &true_sparse_path,
+                "the true COLMAP model (e.g. workspace_synthesizer's sparse_true/); images "
+                "matched by name");
     manager.SetInputPaths([&] {
       mr::WorkspaceOptions ws_options;
       ws_options.use_masks = false;
       std::vector<std::string> inputs = mr::WorkspaceInputPaths(workspace_path, ws_options);
       inputs.push_back(input_path);
       inputs.push_back(gt_path);
+      for (const std::string& dir : {sparse_path, true_sparse_path}) {
+        if (dir.empty()) continue;
+        for (const char* file : {"cameras", "images", "points3D"}) {
+          for (const char* ext : {".bin", ".txt"}) {
+            inputs.push_back(mr::JoinPaths(dir, std::string(file) + ext));
+          }
+        }
+      }
       return inputs;
     });
     if (!manager.Parse(argc, argv)) return 0;
@@ -54,6 +77,13 @@ int main(int argc, char** argv) {
     for (const std::string& path : {input_path, gt_path}) {
       if (mr::ExistsDir(path)) MR_THROW_INPUT << path << ": is a folder; expected a mesh file";
       if (!mr::ExistsFile(path)) MR_THROW_INPUT << path << ": file does not exist";
+    }
+    if (sparse_path.empty() != true_sparse_path.empty()) {
+      MR_THROW_INPUT << "--sparse_path and --true_sparse_path go together (got only "
+                     << (sparse_path.empty() ? "--true_sparse_path" : "--sparse_path") << ")";
+    }
+    for (const std::string& dir : {sparse_path, true_sparse_path}) {
+      if (!dir.empty() && !mr::ExistsDir(dir)) MR_THROW_INPUT << dir << ": folder does not exist";
     }
     const mr::TriangleMesh mesh = mr::ReadMesh(input_path);
     const mr::TriangleMesh gt = mr::ReadMesh(gt_path);
@@ -74,7 +104,13 @@ int main(int argc, char** argv) {
     }
     const mr::EvaluationResult result = mr::EvaluateMesh(mesh.V, mesh.F, gt.V, gt.F, options,
                                                          observed.empty() ? nullptr : &observed);
-    std::cout << result.ToJson() << std::endl;
+    std::string json = result.ToJson();
+    if (!sparse_path.empty()) {
+      const mr::CameraComparison cameras = mr::CompareCameras(
+          mr::ReadSparseModel(sparse_path), mr::ReadSparseModel(true_sparse_path), gt.V);
+      json.insert(json.size() - 1, ", " + cameras.JsonMembers());
+    }
+    std::cout << json << std::endl;
     return 0;
   });
 }

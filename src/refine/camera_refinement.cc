@@ -554,10 +554,11 @@ std::vector<OrderedPair> CollectSamples(const std::vector<cv::Mat>& gray_images,
 
 // The least-squares problem over `params` (which it points into): the
 // photometric residuals of every sample and the priors of every view (and
-// camera) they involve. `refined` receives which views take part.
+// camera) they involve, centred on `prior` (same layout as `params`).
+// `refined` receives which views take part.
 void BuildProblem(const std::vector<cv::Mat>& gray_images, const std::vector<OrderedPair>& ordered,
                   const std::vector<double>& footprint, const CameraRefinementOptions& options,
-                  CameraParameters* params, ceres::Problem* problem,
+                  const CameraParameters& prior, CameraParameters* params, ceres::Problem* problem,
                   ceres::ParameterBlockOrdering* ordering, std::vector<char>* refined) {
   CameraParameters& p = *params;
   // Huber on r with threshold huber_delta, weighed as residuals of std dev
@@ -590,8 +591,8 @@ void BuildProblem(const std::vector<cv::Mat>& gray_images, const std::vector<Ord
   ceres::Manifold* manifold = internal::NewRotationMatrixManifold();
   for (size_t i = 0; i < refined->size(); ++i) {
     if (!(*refined)[i]) continue;
-    const Eigen::Matrix3d R0 = Eigen::Map<const internal::RowMatrix3d>(p.rotation[i].data());
-    const Eigen::Vector3d C0 = Eigen::Map<const Eigen::Vector3d>(p.center[i].data());
+    const Eigen::Matrix3d R0 = Eigen::Map<const internal::RowMatrix3d>(prior.rotation[i].data());
+    const Eigen::Vector3d C0 = Eigen::Map<const Eigen::Vector3d>(prior.center[i].data());
     problem->SetManifold(p.rotation[i].data(), manifold);
     problem->AddResidualBlock(
         new ceres::AutoDiffCostFunction<internal::RotationPrior, 3, 9>(
@@ -605,7 +606,8 @@ void BuildProblem(const std::vector<cv::Mat>& gray_images, const std::vector<Ord
     ordering->AddElementToGroup(p.rotation[i].data(), 1);
     ordering->AddElementToGroup(p.center[i].data(), 1);
   }
-  for (auto& k : p.intrinsics) {
+  for (size_t b = 0; b < p.intrinsics.size(); ++b) {
+    std::array<double, 4>& k = p.intrinsics[b];
     if (!problem->HasParameterBlock(k.data())) continue;
     ordering->AddElementToGroup(k.data(), 1);
     if (options.mode != "poses_intrinsics") {
@@ -614,7 +616,8 @@ void BuildProblem(const std::vector<cv::Mat>& gray_images, const std::vector<Ord
     }
     problem->AddResidualBlock(
         new ceres::AutoDiffCostFunction<internal::FocalPrior, 2, 4>(
-            new internal::FocalPrior(k[0], k[1], options.prior_focal_percent / 100.0)),
+            new internal::FocalPrior(prior.intrinsics[b][0], prior.intrinsics[b][1],
+                                     options.prior_focal_percent / 100.0)),
         nullptr, k.data());
   }
 }
@@ -655,10 +658,19 @@ CameraRefinementSummary RefineCameras(const std::vector<cv::Mat>& gray_images,
                                       const Eigen::MatrixXd& V, const Eigen::MatrixXi& F,
                                       Renderer* renderer, const std::vector<int>& camera_of_view,
                                       const CameraRefinementOptions& options,
-                                      std::vector<PinholeView>* views) {
+                                      std::vector<PinholeView>* views,
+                                      const std::vector<PinholeView>* prior_views) {
   options.Check();
   MR_CHECK(views != nullptr && renderer != nullptr);
   CheckInputs(gray_images, pairs, V, F, camera_of_view, *views);
+  if (prior_views != nullptr) {
+    MR_CHECK_EQ(prior_views->size(), views->size());
+    for (size_t i = 0; i < views->size(); ++i) {
+      MR_CHECK((*prior_views)[i].width == (*views)[i].width &&
+               (*prior_views)[i].height == (*views)[i].height)
+          << "view " << i << ": prior and start views differ in resolution";
+    }
+  }
   const double start_s = ElapsedSeconds();
   const int num_views = static_cast<int>(views->size());
   const bool intrinsics = options.mode == "poses_intrinsics";
@@ -670,6 +682,8 @@ CameraRefinementSummary RefineCameras(const std::vector<cv::Mat>& gray_images,
   summary.footprint.assign(num_views, 0.0);
 
   CameraParameters params = InitialParameters(*views, camera_of_view, intrinsics);
+  const CameraParameters prior =
+      prior_views == nullptr ? params : InitialParameters(*prior_views, camera_of_view, intrinsics);
   const std::vector<OrderedPair> ordered = CollectSamples(
       gray_images, pairs, V, F, renderer, *views, options.max_samples_per_pair, &summary.footprint);
   summary.num_ordered_pairs = static_cast<int>(ordered.size());
@@ -684,8 +698,8 @@ CameraRefinementSummary RefineCameras(const std::vector<cv::Mat>& gray_images,
   ceres::Problem problem;
   auto ordering = std::make_shared<ceres::ParameterBlockOrdering>();
   std::vector<char> refined(num_views, 0);
-  BuildProblem(gray_images, ordered, summary.footprint, options, &params, &problem, ordering.get(),
-               &refined);
+  BuildProblem(gray_images, ordered, summary.footprint, options, prior, &params, &problem,
+               ordering.get(), &refined);
   summary.num_views_refined = static_cast<int>(std::count(refined.begin(), refined.end(), 1));
 
   ceres::Solver::Options solver;

@@ -111,6 +111,10 @@ struct CameraRefinementSummary {
 // share one refined set. Empty: one camera per view. `renderer` renders the mesh (its
 // current mesh is replaced). Views in no pair keep their pose (but take their
 // camera's new intrinsics). Samples are picked once, at the start poses.
+// `prior_views` (optional, same size and resolution as `views`): the cameras
+// the priors hold the views near, e.g. the SfM cameras when `views` are the
+// result of an earlier refinement; without it, the start views. The reported
+// changes are from the start views.
 // Returns with the cameras unchanged (and a WARNING) if no pair has samples
 // or Ceres finds no usable solution. Throws InputError on bad options or
 // inputs.
@@ -119,7 +123,8 @@ CameraRefinementSummary RefineCameras(const std::vector<cv::Mat>& gray_images,
                                       const Eigen::MatrixXd& V, const Eigen::MatrixXi& F,
                                       Renderer* renderer, const std::vector<int>& camera_of_view,
                                       const CameraRefinementOptions& options,
-                                      std::vector<PinholeView>* views);
+                                      std::vector<PinholeView>* views,
+                                      const std::vector<PinholeView>* prior_views = nullptr);
 
 namespace internal {
 

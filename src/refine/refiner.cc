@@ -72,14 +72,17 @@ std::vector<PinholeView> LevelViews(const std::vector<PinholeView>& cameras, int
   return views;
 }
 
-// refine_cameras: refines the level's views against the current mesh and
-// carries the result to the working-resolution cameras (a level's intrinsics
-// are the full ones times 2^-level exactly, PyramidLevelView).
+// refine_cameras: refines the level's views against the current mesh, with
+// priors that hold them near `input_cameras` (the SfM cameras at the working
+// resolution, so that repeated refinements do not wander), and carries the
+// result to the working-resolution cameras (a level's intrinsics are the full
+// ones times 2^-level exactly, PyramidLevelView).
 void RefineCamerasAtLevel(const RefineOptions& options,
                           const std::vector<std::pair<int, int>>& pairs, const Eigen::MatrixXd& V,
                           const Eigen::MatrixXi& F, int level,
                           const std::vector<int>& camera_of_view, Renderer* renderer,
-                          size_t max_bytes, ImageCache* images, std::vector<PinholeView>* views,
+                          size_t max_bytes, const std::vector<PinholeView>& input_cameras,
+                          ImageCache* images, std::vector<PinholeView>* views,
                           std::vector<PinholeView>* cameras, RefineSummary* summary) {
   size_t bytes = 0;
   for (const PinholeView& view : *views) bytes += size_t(view.width) * view.height * sizeof(float);
@@ -93,8 +96,9 @@ void RefineCamerasAtLevel(const RefineOptions& options,
   for (int i = 0; i < static_cast<int>(views->size()); ++i) gray.push_back(images->Gray(i, level));
   CameraRefinementOptions camera_options = options.camera_refinement;
   camera_options.mode = options.refine_cameras;
+  const std::vector<PinholeView> prior = LevelViews(input_cameras, level);
   const CameraRefinementSummary refined =
-      RefineCameras(gray, pairs, V, F, renderer, camera_of_view, camera_options, views);
+      RefineCameras(gray, pairs, V, F, renderer, camera_of_view, camera_options, views, &prior);
   MR_LOG(INFO) << "Level " << level << " cameras: " << refined.BriefReport();
   MR_LOG(VERBOSE) << refined.FullReport();
   summary->camera_reports.push_back("level " + std::to_string(level) + ": " + refined.BriefReport());
@@ -527,7 +531,7 @@ RefineSummary RefineMesh(const ViewSource& input_source, const RefineOptions& op
     RemeshForLevel(views, options, max_faces, &V, &F);
     if (options.refine_cameras != "none") {
       RefineCamerasAtLevel(options, pairs, V, F, level, camera_of_view, renderer, cache_bytes / 2,
-                           &images, &views, &cameras, &summary);
+                           full_views, &images, &views, &cameras, &summary);
     }
     double level_seconds = 0;  // of this level's iterations so far, for the ETA
     guard_verified_clean = false;
@@ -566,7 +570,7 @@ RefineSummary RefineMesh(const ViewSource& input_source, const RefineOptions& op
       if (options.refine_cameras != "none" && level == 0 && it > 0 &&
           it == options.iterations_per_level / 2) {
         RefineCamerasAtLevel(options, pairs, V, F, level, camera_of_view, renderer,
-                             cache_bytes / 2, &images, &views, &cameras, &summary);
+                             cache_bytes / 2, full_views, &images, &views, &cameras, &summary);
       }
       const Eigen::MatrixXd V_before = V;
       renderer->SetMesh(V, F);

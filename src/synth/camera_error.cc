@@ -4,7 +4,9 @@
 #include <cmath>
 #include <limits>
 #include <random>
+#include <set>
 #include <sstream>
+#include <utility>
 
 #include <Eigen/Geometry>
 
@@ -225,6 +227,51 @@ CameraErrorSummary PerturbCameras(const CameraErrorOptions& options,
     summary.focal_scale[camera_id] = scale;
   }
   return summary;
+}
+
+std::string CameraComparison::JsonMembers() const {
+  std::ostringstream s;
+  s.precision(6);
+  s << "\"camera_images\": " << num_images << ", \"camera_rms_px\": " << rms_px
+    << ", \"camera_max_rms_px\": " << max_rms_px << ", \"camera_max_rms_image\": \""
+    << max_rms_image << "\", \"camera_max_focal_percent\": " << max_focal_percent;
+  return s.str();
+}
+
+CameraComparison CompareCameras(const Reconstruction& model, const Reconstruction& truth,
+                                const Eigen::MatrixXd& surface_points) {
+  std::map<std::string, const Image*> true_by_name;
+  for (const auto& [id, image] : truth.images) true_by_name[image.name] = &image;
+  CameraComparison comparison;
+  double sum_sq = 0;
+  std::set<std::pair<uint32_t, uint32_t>> cameras_seen;  // (model, true) camera ids
+  for (const auto& [id, image] : model.images) {
+    const auto match = true_by_name.find(image.name);
+    if (match == true_by_name.end()) {
+      MR_THROW_INPUT << "image " << image.name << " (id " << id
+                     << ") is not in the true model";
+    }
+    const Image& true_image = *match->second;
+    const Camera& camera = model.cameras.at(image.camera_id);
+    const Camera& true_camera = truth.cameras.at(true_image.camera_id);
+    const double rms = ReprojectionRms(ViewFromColmap(true_camera, true_image),
+                                       ViewFromColmap(camera, image), surface_points);
+    sum_sq += rms * rms;
+    if (rms > comparison.max_rms_px || comparison.num_images == 0) {
+      comparison.max_rms_px = rms;
+      comparison.max_rms_image = image.name;
+    }
+    ++comparison.num_images;
+    if (!cameras_seen.emplace(image.camera_id, true_image.camera_id).second) continue;
+    const PinholeView view = ViewFromColmap(camera, image);
+    const PinholeView true_view = ViewFromColmap(true_camera, true_image);
+    for (const double ratio : {view.fx / true_view.fx, view.fy / true_view.fy}) {
+      comparison.max_focal_percent =
+          std::max(comparison.max_focal_percent, 100 * std::abs(ratio - 1));
+    }
+  }
+  if (comparison.num_images > 0) comparison.rms_px = std::sqrt(sum_sq / comparison.num_images);
+  return comparison;
 }
 
 }  // namespace mr

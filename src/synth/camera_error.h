@@ -79,4 +79,26 @@ CameraErrorSummary PerturbCameras(const CameraErrorOptions& options,
 double ReprojectionRms(const PinholeView& true_view, const PinholeView& other_view,
                        const Eigen::MatrixXd& surface_points, int* num_visible = nullptr);
 
+// How far the cameras of `model` are from those of `truth`, image by image
+// (matched by name): the RMS displacement of the projections of the
+// `surface_points` that each true view sees (ReprojectionRms), and each
+// camera's focal error. What a camera refinement is judged by.
+struct CameraComparison {
+  int num_images = 0;              // images of `model` compared (all of them)
+  double rms_px = 0;               // sqrt of the mean over images of their RMS squared
+  double max_rms_px = 0;           // worst image
+  std::string max_rms_image;       // its name
+  double max_focal_percent = 0;    // worst |fx / fx_true - 1| (and fy) over cameras, in %
+
+  // `"camera_images": n, "camera_rms_px": ..., ...` (JSON members, no braces).
+  std::string JsonMembers() const;
+};
+
+// Every image of `model` must be in `truth` under the same name, with a
+// PINHOLE or SIMPLE_PINHOLE camera in both (InputError otherwise, naming it);
+// `truth` may hold more images. An image whose true view sees none of the
+// points counts as 0 px.
+CameraComparison CompareCameras(const Reconstruction& model, const Reconstruction& truth,
+                                const Eigen::MatrixXd& surface_points);
+
 }  // namespace mr

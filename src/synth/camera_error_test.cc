@@ -420,5 +420,60 @@ TEST(Synthesizer, PoseErrorWritesTrueModelBesideWorkspace) {
               wrong.camera_error.mean_center_shift);
 }
 
+// CompareCameras measures what PerturbCameras did: 0 for the same model, the
+// per-image RMS of ReprojectionRms combined as an RMS over images, the worst
+// image, and the focal error; images are matched by name.
+TEST(CompareCameras, MeasuresThePerturbation) {
+  const Eigen::MatrixXd P = SpherePoints(4000, 30);
+  const Reconstruction truth = ModelOf(RingViews(), P);
+  const CameraComparison same = CompareCameras(truth, truth, P);
+  EXPECT_EQ(same.num_images, 8);
+  EXPECT_LT(same.rms_px, 1e-9);  // world -> camera -> world round-off
+  EXPECT_LT(same.max_rms_px, 1e-9);
+  EXPECT_EQ(same.max_focal_percent, 0);
+
+  CameraErrorOptions options;
+  options.pose_error_px = 1;
+  options.focal_error_percent = 0.5;
+  Reconstruction model = truth;
+  PerturbCameras(options, P, 5, &model);
+  double sum_sq = 0, worst = 0;
+  uint32_t worst_id = 0;
+  for (uint32_t id = 1; id <= 8; ++id) {
+    const double rms = TestRms(ViewOf(truth, id), ViewOf(model, id), P);
+    sum_sq += rms * rms;
+    if (rms > worst) worst = rms, worst_id = id;
+  }
+  const CameraComparison cmp = CompareCameras(model, truth, P);
+  EXPECT_EQ(cmp.num_images, 8);
+  EXPECT_NEAR(cmp.rms_px, std::sqrt(sum_sq / 8), 1e-9);
+  EXPECT_NEAR(cmp.max_rms_px, worst, 1e-9);
+  EXPECT_EQ(cmp.max_rms_image, model.images.at(worst_id).name);
+  EXPECT_NEAR(cmp.max_focal_percent, 0.5, 1e-9);
+  EXPECT_GT(cmp.rms_px, 0.5);  // the focal error adds to the 1 px of the poses
+  const std::string json = "{" + cmp.JsonMembers() + "}";
+  EXPECT_NE(json.find("\"camera_rms_px\": "), std::string::npos) << json;
+
+  // Matched by name, not id: the ids of the truth renumbered.
+  Reconstruction renumbered;
+  renumbered.cameras = truth.cameras;
+  for (const auto& [id, image] : truth.images) {
+    Image copy = image;
+    copy.image_id = id + 100;
+    renumbered.images[id + 100] = copy;
+  }
+  EXPECT_NEAR(CompareCameras(model, renumbered, P).rms_px, cmp.rms_px, 1e-12);
+
+  // An image the truth does not have is an input error that names it.
+  Reconstruction stranger = model;
+  stranger.images.at(3).name = "not_there.png";
+  try {
+    CompareCameras(stranger, truth, P);
+    ADD_FAILURE() << "no error";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("not_there.png"), std::string::npos) << e.what();
+  }
+}
+
 }  // namespace
 }  // namespace mr
