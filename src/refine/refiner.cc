@@ -529,7 +529,11 @@ RefineSummary RefineMesh(const ViewSource& input_source, const RefineOptions& op
   for (int level = num_levels - 1; level >= 0; --level) {
     std::vector<PinholeView> views = LevelViews(cameras, level);
     RemeshForLevel(views, options, max_faces, &V, &F);
-    if (options.refine_cameras != "none") {
+    // Not at the first level's start: the input mesh (a Poisson surface, a
+    // visual hull) is too far off for the images to tell its errors from
+    // the cameras', and cameras fitted to it drift (measured on the corpus,
+    // docs/camera_refinement.md); the first level's iterations come first.
+    if (options.refine_cameras != "none" && level != num_levels - 1) {
       RefineCamerasAtLevel(options, pairs, V, F, level, camera_of_view, renderer, cache_bytes / 2,
                            full_views, &images, &views, &cameras, &summary);
     }
@@ -764,8 +768,8 @@ void RegisterRefineOptions(OptionManager* o, RefineOptions* r) {
          "bilateral_normal (normals filtered, vertices fitted), lp (content-aware L_p), laplacian "
          "or none");
   o->Add("Refine.refine_cameras", &r->refine_cameras,
-         "photometric camera refinement at the start of every level: none, poses, "
-         "poses_intrinsics");
+         "photometric camera refinement at the start of every level but the first and halfway "
+         "through the finest: none, poses, poses_intrinsics");
   o->Add("CameraRefinement.max_samples_per_pair", &r->camera_refinement.max_samples_per_pair,
          "pixels sampled per ordered view pair (>= 1)");
   o->Add("CameraRefinement.intensity_sigma", &r->camera_refinement.intensity_sigma,

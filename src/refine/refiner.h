@@ -114,12 +114,15 @@ struct RefineOptions {
   // "none".
   std::string regularizer = "bilateral_normal";
   // Photometric refinement of the cameras against the current mesh at the
-  // start of every level, after its remeshing (camera_refinement.h): "none",
-  // "poses" (rotation and centre of every view) or "poses_intrinsics" (also
-  // fx, fy, cx, cy, shared by the views of one camera). The level's images of
-  // all views are held at once for it; a level whose images would take more
-  // than half of cache_mb is not refined (logged). Default "none": not yet
-  // measured on the corpus.
+  // start of every level but the first, after its remeshing, and halfway
+  // through the finest level (camera_refinement.h), with priors centred on
+  // the input cameras: "none", "poses" (rotation and centre of every view)
+  // or "poses_intrinsics" (also fx, fy, cx, cy, shared by the views of one
+  // camera). The level's images of all views are held at once for it; a
+  // level whose images would take more than half of cache_mb is not refined
+  // (logged). Default "none": on the corpus it helps where the cameras are
+  // 0.5-2 px off, but on COLMAP's own cameras of templeSparseRing it lowers
+  // the held-out photo-consistency (docs/camera_refinement.md).
   std::string refine_cameras = "none";
   CameraRefinementOptions camera_refinement;  // its mode follows refine_cameras
   // lp proximal step: estimate the noise to remove from what the gradient
