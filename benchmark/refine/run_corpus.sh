@@ -18,14 +18,8 @@
 # at another build's bin/.
 set -euo pipefail
 cd "$(dirname "$0")/../.."
-OUT=${1:?usage: run_corpus.sh OUT_DIR [case ...]}
-shift || true
-OUT=$(realpath -m "$OUT")
-BIN=${BIN:-$PWD/build/bin}
-MODELS=$(realpath ../shared/data/models)
-CORPUS=benchmark/refine/corpus.txt
-export QT_QPA_PLATFORM=offscreen
-mkdir -p "$OUT"
+# shellcheck source=benchmark/refine/corpus_lib.sh
+source benchmark/refine/corpus_lib.sh
 
 configs=""
 if [ "${DEFAULTS:-1}" != 0 ]; then configs+="defaults|"$'\n'; fi
@@ -45,8 +39,7 @@ evaluate() {  # case mesh -> json on stdout
 TSV="$OUT/results.tsv"
 : > "$TSV"
 for name in $cases; do
-  line=$(grep -E "^$name\s*\|" "$CORPUS") || { echo "unknown case: $name" >&2; exit 2; }
-  flags=$(echo "${line#*|}" | sed "s#--model_path #--model_path $MODELS/#")
+  flags=$(case_flags "$name")
   ws="$OUT/$name"
   if [ ! -f "$ws/dense/meshed-poisson.ply" ]; then
     rm -rf "$ws"

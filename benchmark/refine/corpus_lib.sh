@@ -1,0 +1,19 @@
+# Sourced by run_corpus.sh and run_cameras.sh, from the checkout's root with
+# their arguments (OUT_DIR [case ...]): sets OUT (made absolute and created),
+# BIN, MODELS, CORPUS, shifts OUT_DIR off the arguments, and defines
+# case_flags NAME: the case's workspace_synthesizer flags from corpus.txt,
+# with the model path made absolute.
+OUT=${1:?usage: $(basename "$0") OUT_DIR [case ...]}
+shift
+OUT=$(realpath -m "$OUT")
+BIN=${BIN:-$PWD/build/bin}
+MODELS=$(realpath ../shared/data/models)
+CORPUS=benchmark/refine/corpus.txt
+export QT_QPA_PLATFORM=offscreen
+mkdir -p "$OUT"
+
+case_flags() {
+  local line
+  line=$(grep -E "^$1\s*\|" "$CORPUS") || { echo "unknown case: $1" >&2; exit 2; }
+  echo "${line#*|}" | sed "s#--model_path #--model_path $MODELS/#"
+}
