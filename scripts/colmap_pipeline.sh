@@ -128,8 +128,13 @@ else
       if [ "$count" -gt "$best_count" ]; then best=$model best_count=$count; fi
     done
   }
-  run mapper "$colmap" mapper --database_path "$db" --image_path "$image_path" \
-    --output_path "$scratch/default"
+  # The defaults may fail outright ("failed to create sparse model"): that
+  # counts as no image registered, and the lenient run below decides.
+  log "  mapper: $colmap mapper --database_path $db --image_path $image_path --output_path $scratch/default"
+  if ! "$colmap" mapper --database_path "$db" --image_path "$image_path" \
+      --output_path "$scratch/default" > "$logs/mapper.log" 2>&1; then
+    log "  mapper failed with its defaults ($(grep -m1 -o 'ERROR.*' "$logs/mapper.log" || echo "see $logs/mapper.log"))"
+  fi
   consider "$scratch"/default/*/
   if [ "$best_count" -lt "$num_images" ]; then
     log "  mapper registered $best_count of $num_images images with its defaults; again with a lenient initialisation (init_min_tri_angle 4, init_min_num_inliers 50, abs_pose_min_num_inliers 15)"
