@@ -75,9 +75,10 @@ run() {
   fi
 }
 
-version=$("$colmap" -h 2>&1 | head -n 1 || true)
+help_text=$("$colmap" -h 2>&1 || true)
+version=${help_text%%$'\n'*}
 cuda=0
-if "$colmap" -h 2>&1 | head -n 3 | grep -q "with CUDA"; then cuda=1; fi
+case "$help_text" in *"with CUDA"*) cuda=1 ;; esac
 log "COLMAP: $(command -v "$colmap"): $version"
 if [ "$cuda" = 1 ]; then
   log "route: COLMAP has CUDA: GPU SIFT, dense stereo, fusion and Poisson, then mesh_refiner"
@@ -118,13 +119,17 @@ else
   processed=$(grep -c "Processed file" "$logs/feature_extractor.log" || true)
   unreadable=$(grep -c "Failed to read image" "$logs/feature_extractor.log" || true)
   num_images=$((processed - unreadable))
-  # best_model DIR...: the model folder with the most registered images.
+  # consider DIR...: keeps in best the model folder with the most registered images.
   best="" best_count=0
   consider() {
-    local model count
+    local model count analysis
     for model in "$@"; do
       [ -f "$model/images.bin" ] || continue
-      count=$("$colmap" model_analyzer --path "$model" 2>&1 | grep -m1 -o "Registered images: [0-9]*" | grep -o "[0-9]*$" || echo 0)
+      # The analyzer's whole output first: under pipefail, a reader that
+      # stops early (grep -m1, head) fails the pipeline with SIGPIPE.
+      analysis=$("$colmap" model_analyzer --path "$model" 2>&1 || true)
+      count=0
+      if [[ $analysis =~ Registered\ images:\ ([0-9]+) ]]; then count=${BASH_REMATCH[1]}; fi
       if [ "$count" -gt "$best_count" ]; then best=$model best_count=$count; fi
     done
   }

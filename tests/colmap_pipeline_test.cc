@@ -71,6 +71,8 @@ TEST(ColmapPipeline, TempleFromPhotosOnTheCpuRoute) {
   ASSERT_EQ(run.exit_code, 0) << run.output;
   EXPECT_NE(run.output.find("COLMAP: "), std::string::npos) << run.output;
   EXPECT_NE(run.output.find("route: COLMAP has no CUDA"), std::string::npos) << run.output;
+  // No shell error on the way (bash prefixes them with "<script>: line N:").
+  EXPECT_EQ(run.output.find("colmap_pipeline.sh: line "), std::string::npos) << run.output;
 
   // COLMAP's model: the images registered (the default mapper leaves some
   // of this wide-baseline ring out; the script then retries leniently).
