@@ -254,8 +254,9 @@ CameraComparison CompareCameras(const Reconstruction& model, const Reconstructio
     const Image& true_image = *match->second;
     const Camera& camera = model.cameras.at(image.camera_id);
     const Camera& true_camera = truth.cameras.at(true_image.camera_id);
-    const double rms = ReprojectionRms(ViewFromColmap(true_camera, true_image),
-                                       ViewFromColmap(camera, image), surface_points);
+    const PinholeView view = ViewFromColmap(camera, image);
+    const PinholeView true_view = ViewFromColmap(true_camera, true_image);
+    const double rms = ReprojectionRms(true_view, view, surface_points);
     sum_sq += rms * rms;
     if (rms > comparison.max_rms_px || comparison.num_images == 0) {
       comparison.max_rms_px = rms;
@@ -263,8 +264,6 @@ CameraComparison CompareCameras(const Reconstruction& model, const Reconstructio
     }
     ++comparison.num_images;
     if (!cameras_seen.emplace(image.camera_id, true_image.camera_id).second) continue;
-    const PinholeView view = ViewFromColmap(camera, image);
-    const PinholeView true_view = ViewFromColmap(true_camera, true_image);
     for (const double ratio : {view.fx / true_view.fx, view.fy / true_view.fy}) {
       comparison.max_focal_percent =
           std::max(comparison.max_focal_percent, 100 * std::abs(ratio - 1));
