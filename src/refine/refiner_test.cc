@@ -182,6 +182,29 @@ double ReprojectionRmsPx(const std::vector<PinholeView>& a, const std::vector<Pi
 // pixel of pose error (as after SfM). Without camera refinement the flow
 // bends the (true) start mesh to fit the wrong cameras; with it the cameras
 // move most of the way back and the mesh stays closer to the truth.
+// max_faces holds even where the remesher's edges come out shorter than its
+// target: with a budget far below what 1.5-pixel edges would need, the level
+// mesh has at most max_faces faces, and not far fewer.
+TEST_F(RefinerTest, FaceBudgetIsRespected) {
+  Eigen::MatrixXd V;
+  Eigen::MatrixXi F;
+  MakeBumpySphere(5, 0.06, &V, &F);
+  const InMemoryViewSource source = MakeTestScene(V, F, {}, {}, renderer_);
+  for (const int max_faces : {3000, 7000}) {
+    TriangleMesh mesh;
+    mesh.V = V;
+    mesh.F = F;
+    RefineOptions options;
+    options.num_levels = 1;
+    options.iterations_per_level = 0;
+    options.target_edge_px = 1.5;
+    options.max_faces = max_faces;
+    RefineMesh(source, options, &mesh, renderer_);
+    EXPECT_LE(mesh.F.rows(), max_faces);
+    EXPECT_GE(mesh.F.rows(), 0.8 * max_faces);
+  }
+}
+
 TEST_F(RefinerTest, CameraRefinementUndoesPoseError) {
   Eigen::MatrixXd V;
   Eigen::MatrixXi F;
