@@ -1,6 +1,6 @@
 # Sourced by run_corpus.sh and run_cameras.sh, from the checkout's root with
 # their arguments (OUT_DIR [case ...]): sets OUT (made absolute and created),
-# BIN, MODELS, CORPUS, shifts OUT_DIR off the arguments, and defines
+# BIN, MODELS, CORPUS (benchmark/refine/corpus.txt unless set), shifts OUT_DIR off the arguments, and defines
 # case_flags NAME: the case's workspace_synthesizer flags from corpus.txt,
 # with the model path made absolute.
 OUT=${1:?usage: $(basename "$0") OUT_DIR [case ...]}
@@ -8,7 +8,7 @@ shift
 OUT=$(realpath -m "$OUT")
 BIN=${BIN:-$PWD/build/bin}
 MODELS=$(realpath ../shared/data/models)
-CORPUS=benchmark/refine/corpus.txt
+CORPUS=${CORPUS:-benchmark/refine/corpus.txt}
 export QT_QPA_PLATFORM=offscreen
 mkdir -p "$OUT"
 
