@@ -1,0 +1,70 @@
+#!/usr/bin/env bash
+# Real-size workspaces (issue #10): mesh_refiner with its defaults on
+#   a) 40 views of 1920x1440, COLMAP's Poisson mesh of the built-in shape;
+#   b) 100 views of 1600x1200;
+#   c) the example's 16 views of 640x480 with a Poisson mesh of about 2M
+#      faces (poisson_mesher at depth 10);
+#   d) 12 views of 6000x4000 (24 MP, rendered without supersampling);
+# each made by workspace_synthesizer (real colmap fusion + Poisson), timed
+# with /usr/bin/time (wall seconds, peak KB) and evaluated on the observed
+# surface. One line per case: the refiner's working resolution and faces,
+# time, memory, accuracy90 and normal error before and after. Workspaces
+# and results in OUT_DIR are reused.
+#
+#   bash benchmark/refine/run_large.sh OUT_DIR [a b c d]
+#
+# REFINER_FLAGS adds flags to every refinement (default: none).
+set -euo pipefail
+cd "$(dirname "$0")/../.."
+OUT=$(realpath -m "${1:?usage: $(basename "$0") OUT_DIR [a b c d]}")
+shift
+cases=${*:-a b c d}
+BIN=${BIN:-$PWD/build/bin}
+export QT_QPA_PLATFORM=offscreen
+mkdir -p "$OUT"
+
+synth_flags() {
+  case $1 in
+    a) echo "--num_views 40 --width 1920 --height 1440" ;;
+    b) echo "--num_views 100 --width 1600 --height 1200 --layout hemisphere" ;;
+    c) echo "--num_views 16 --PoissonMeshing.depth 10" ;;
+    d) echo "--num_views 12 --width 6000 --height 4000 --supersample 1" ;;
+    *) echo "unknown case: $1 (a, b, c or d)" >&2; exit 2 ;;
+  esac
+}
+
+json_field() { python3 -c "import json,sys; print(json.load(open(sys.argv[1]))[sys.argv[2]])" "$@"; }
+
+{
+printf '| case | workspace | working size, faces | wall s | peak MB | accuracy90 in -> out | normal_deg in -> out |\n'
+printf '|---|---|---|---|---|---|---|\n'
+for c in $cases; do
+  flags=$(synth_flags "$c")
+  ws="$OUT/$c"
+  if [ ! -f "$ws/dense/meshed-poisson.ply" ]; then
+    rm -rf "$ws"
+    echo "[$(date +%T)] synthesising $c: $flags" >&2
+    # shellcheck disable=SC2086
+    /usr/bin/time -f "%e %M" -o "$OUT/$c.synth.time" "$BIN/workspace_synthesizer" \
+      --output_path "$ws" $flags > "$OUT/$c.synth.log" 2>&1
+  fi
+  evaluate() {
+    "$BIN/mesh_evaluator" --input_path "$1" --gt_path "$ws/ground_truth.ply" \
+      --workspace_path "$ws/dense"
+  }
+  [ -f "$OUT/$c.input.json" ] || evaluate "$ws/dense/meshed-poisson.ply" > "$OUT/$c.input.json"
+  if [ ! -f "$OUT/$c.json" ]; then
+    echo "[$(date +%T)] refining $c" >&2
+    # shellcheck disable=SC2086
+    /usr/bin/time -f "%e %M" -o "$OUT/$c.time" "$BIN/mesh_refiner" --workspace_path "$ws/dense" \
+      --output_path "$ws/dense/meshed-refined.ply" ${REFINER_FLAGS:-} > "$OUT/$c.log" 2>&1
+    evaluate "$ws/dense/meshed-refined.ply" > "$OUT/$c.json"
+  fi
+  read -r secs kb < "$OUT/$c.time"
+  level=$(grep -m1 -o 'Level 0: [0-9]*x[0-9]* images, [0-9]* faces' "$OUT/$c.log" || true)
+  printf '| %s | %s | %s | %.0f | %d | %.4f -> %.4f | %.2f -> %.2f |\n' "$c" "$flags" \
+    "${level#Level 0: }" "$secs" "$((kb / 1024))" \
+    "$(json_field "$OUT/$c.input.json" accuracy90)" "$(json_field "$OUT/$c.json" accuracy90)" \
+    "$(json_field "$OUT/$c.input.json" normal_deg)" "$(json_field "$OUT/$c.json" normal_deg)"
+done
+} | tee "$OUT/large.md"
