@@ -79,8 +79,11 @@ struct RefineOptions {
   // images are scaled down to it, their cameras with them (ResizedViewSource),
   // as COLMAP's PatchMatchStereo.max_image_size; pyramid levels, pixel
   // footprints and target_edge_px are then taken at this working resolution
-  // (-1: no limit; else >= 32).
-  int max_image_size = -1;
+  // (-1: no limit; else >= 32). 1280 was chosen on corpus cases rendered at
+  // 1920x1440 and 2560x1920 (benchmark/refine/run_image_size.sh): accuracy
+  // still improves above it, but per second spent 5-10 times less than
+  // below it (docs/results.md).
+  int max_image_size = 1280;
   // Target triangle edge length in pixels at every level (> 0). The mesh is
   // remeshed to it when a level starts.
   double target_edge_px = 2.5;
