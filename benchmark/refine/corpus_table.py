@@ -11,17 +11,24 @@ import sys
 ACC_FLOOR, NORMAL_FLOOR, COMPLETENESS_DROP = 0.6, 0.7, 1.0
 
 
-def main(path):
+def read_results(path):
+    """run_corpus.sh's results.tsv: rows (case, label, result dict, seconds,
+    MB), and the labels other than "input" in their order of appearance."""
     rows = []
     with open(path) as f:
         for line in f:
             name, label, js, secs, mb = line.rstrip("\n").split("\t")
             rows.append((name, label, json.loads(js), float(secs), int(mb)))
-    inputs = {name: r for name, label, r, _, _ in rows if label == "input"}
     labels = []
     for _, label, _, _, _ in rows:
         if label != "input" and label not in labels:
             labels.append(label)
+    return rows, labels
+
+
+def main(path):
+    rows, labels = read_results(path)
+    inputs = {name: r for name, label, r, _, _ in rows if label == "input"}
     print("| case | mesh | faces | accuracy90 | x input | normal_deg | x input | "
           "completeness % | - input | chamfer | s | MB | floors |")
     print("|---|---|---|---|---|---|---|---|---|---|---|---|---|")

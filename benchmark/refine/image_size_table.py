@@ -7,21 +7,14 @@ ratios and the slowest run.
 
   python3 benchmark/refine/image_size_table.py OUT_DIR/results.tsv
 """
-import json
 import sys
+
+from corpus_table import read_results
 
 
 def main(path):
-    rows = []
-    with open(path) as f:
-        for line in f:
-            name, label, js, secs, mb = line.rstrip("\n").split("\t")
-            rows.append((name, label, json.loads(js), float(secs), int(mb)))
+    rows, sizes = read_results(path)
     full = {n: r for n, l, r, _, _ in rows if l == "full"}
-    sizes = []
-    for _, label, _, _, _ in rows:
-        if label != "input" and label not in sizes:
-            sizes.append(label)
     print("| case | working size | faces | accuracy90 | / full | normal_deg | / full | "
           "completeness % | s | MB |")
     print("|---|---|---|---|---|---|---|---|---|---|")
