@@ -205,6 +205,45 @@ TEST_F(RefinerTest, FaceBudgetIsRespected) {
   }
 }
 
+// Images without texture carry no information, also when they are not
+// exactly constant: a textureless region scaled by a non-dyadic factor holds
+// rounding noise of ~1e-7 (here a fixed pattern in each image). The flow must
+// not follow it: before the information floor, -G / (H + mu) of that noise
+// sent vertices to the step limit every iteration.
+TEST_F(RefinerTest, RoundingNoiseOfATexturelessImageMovesNothing) {
+  Eigen::MatrixXd V;
+  Eigen::MatrixXi F;
+  MakeBumpySphere(5, 0.06, &V, &F);
+  const InMemoryViewSource textured = MakeTestScene(V, F, {}, {}, renderer_);
+  InMemoryViewSource source;
+  for (int i = 0; i < textured.NumViews(); ++i) {
+    const PinholeView& view = textured.View(i);
+    cv::Mat gray(view.height, view.width, CV_32F);
+    for (int y = 0; y < gray.rows; ++y) {
+      for (int x = 0; x < gray.cols; ++x) {
+        gray.at<float>(y, x) = 0.5f + 1e-7f * static_cast<float>((7 * x + 13 * y + 3 * i) % 5);
+      }
+    }
+    source.Add(textured.Name(i), view, gray);
+  }
+  TriangleMesh mesh;
+  mesh.V = V;
+  mesh.F = F;
+  RefineOptions options;
+  options.num_levels = 1;
+  options.iterations_per_level = 3;
+  options.regularizer = "none";
+  TriangleMesh remeshed = mesh;
+  RefineOptions remesh_only = options;
+  remesh_only.iterations_per_level = 0;
+  RefineMesh(source, remesh_only, &remeshed, renderer_);
+  const RefineSummary summary = RefineMesh(source, options, &mesh, renderer_);
+  ASSERT_EQ(mesh.V.rows(), remeshed.V.rows());
+  const double moved = (mesh.V - remeshed.V).rowwise().norm().maxCoeff();
+  const double footprint = MedianFootprint(source.Views(), V, VertexNormals(V, F));
+  EXPECT_LT(moved, 0.01 * footprint) << summary.FullReport();
+}
+
 TEST_F(RefinerTest, CameraRefinementUndoesPoseError) {
   Eigen::MatrixXd V;
   Eigen::MatrixXi F;
