@@ -641,7 +641,7 @@ RefineSummary RefineMesh(const ViewSource& input_source, const RefineOptions& op
       const double mu = options.damping * MedianPositive(information);
       Eigen::MatrixXd step = Eigen::MatrixXd::Zero(V.rows(), 3);
       for (int v = 0; v < V.rows(); ++v) {
-        if (information(v) > 0 && information(v) + mu > 0) {
+        if (information(v) > 0) {
           step.row(v) = -options.step * term.gradient.row(v) / (term.curvature(v) + mu);
         }
       }

@@ -178,10 +178,6 @@ double ReprojectionRmsPx(const std::vector<PinholeView>& a, const std::vector<Pi
   return n > 0 ? std::sqrt(sum / n) : 0.0;
 }
 
-// --Refine.refine_cameras: the images are true, the cameras carry about a
-// pixel of pose error (as after SfM). Without camera refinement the flow
-// bends the (true) start mesh to fit the wrong cameras; with it the cameras
-// move most of the way back and the mesh stays closer to the truth.
 // max_faces holds even where the remesher's edges come out shorter than its
 // target: with a budget far below what 1.5-pixel edges would need, the level
 // mesh has at most max_faces faces, and not far fewer.
@@ -244,6 +240,10 @@ TEST_F(RefinerTest, RoundingNoiseOfATexturelessImageMovesNothing) {
   EXPECT_LT(moved, 0.01 * footprint) << summary.FullReport();
 }
 
+// --Refine.refine_cameras: the images are true, the cameras carry about a
+// pixel of pose error (as after SfM). Without camera refinement the flow
+// bends the (true) start mesh to fit the wrong cameras; with it the cameras
+// move most of the way back and the mesh stays closer to the truth.
 TEST_F(RefinerTest, CameraRefinementUndoesPoseError) {
   Eigen::MatrixXd V;
   Eigen::MatrixXi F;
