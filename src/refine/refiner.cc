@@ -56,6 +56,20 @@ class RenderCache {
     bytes_ = 0;
   }
   long num_renders() const { return num_renders_; }
+  // All view indices: the cached ones from the most recently used, then the
+  // others in index order.
+  std::vector<int> CachedFirst() const {
+    std::vector<int> order;
+    std::vector<char> listed(views_.size(), 0);
+    for (const auto& entry : entries_) {
+      order.push_back(entry.first);
+      listed[entry.first] = 1;
+    }
+    for (int i = 0; i < static_cast<int>(views_.size()); ++i) {
+      if (!listed[i]) order.push_back(i);
+    }
+    return order;
+  }
 
  private:
   Renderer* renderer_;
@@ -568,6 +582,7 @@ RefineSummary RefineMesh(const ViewSource& input_source, const RefineOptions& op
     Eigen::MatrixXd V_last_iterate;  // the mesh whose similarity is previous_similarity
     for (int it = 0; it < options.iterations_per_level; ++it, ++global_iteration) {
       const double t_iter = ElapsedSeconds();
+      const long renders_before = renders.num_renders();
       RefineIteration record;
       record.level = level;
       record.iteration = it;
@@ -665,10 +680,13 @@ RefineSummary RefineMesh(const ViewSource& input_source, const RefineOptions& op
         Eigen::MatrixXd sil = Eigen::MatrixXd::Zero(V.rows(), 3);
         Eigen::VectorXd count = Eigen::VectorXd::Zero(V.rows());
         const Eigen::MatrixXd N = VertexNormals(V, F);
-        for (int i = 0; i < static_cast<int>(views.size()); ++i) {
+        // The renders the data term left in the cache first: in index order
+        // an LRU cache smaller than the level's renders evicts each one just
+        // before it is needed.
+        for (const int i : renders.CachedFirst()) {
           const cv::Mat mask = images.Mask(i, level);
           if (mask.empty()) continue;
-          AccumulateSilhouetteTerm(V, F, N, views[i], *renders.Get(i), SignedDistanceToMask(mask),
+          AccumulateSilhouetteTerm(V, F, N, views[i], *renders.Get(i), mask,
                                    3.0 * options.max_step_px, &sil, &count);
         }
         for (int v = 0; v < V.rows(); ++v) {
@@ -719,7 +737,8 @@ RefineSummary RefineMesh(const ViewSource& input_source, const RefineOptions& op
                    << "), " << record.regularizer_report << "; " << record.seconds
                    << " s (data " << record.data_seconds << ", silhouette "
                    << record.silhouette_seconds << ", denoise " << record.denoise_seconds
-                   << ", clean-up " << record.cleanup_seconds << "); ETA "
+                   << ", clean-up " << record.cleanup_seconds << "; "
+                   << renders.num_renders() - renders_before << " renders); ETA "
                    << FormatSeconds(eta);
       summary.iterations.push_back(record);
     }

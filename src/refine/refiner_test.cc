@@ -1,9 +1,12 @@
 #include <gtest/gtest.h>
 
+#include <algorithm>
+#include <cmath>
 #include <cstdio>
 #include <random>
 
 #include <Eigen/Geometry>
+#include <opencv2/imgproc.hpp>
 
 #include "eval/evaluator.h"
 #include "geometry/mesh.h"
@@ -378,8 +381,7 @@ TEST_F(RefinerTest, SilhouetteTermFollowsTheGapBetweenOutlines) {
     Eigen::MatrixXd d = Eigen::MatrixXd::Zero(V.rows(), 3);
     Eigen::VectorXd count = Eigen::VectorXd::Zero(V.rows());
     AccumulateSilhouetteTerm(V, F, N, view, render,
-                             SignedDistanceToMask(coverage(larger ? big_render : render)), 3.0, &d,
-                             &count);
+                             coverage(larger ? big_render : render), 3.0, &d, &count);
     double radial_sum = 0;
     int contour = 0;
     for (int v = 0; v < V.rows(); ++v) {
@@ -399,6 +401,52 @@ TEST_F(RefinerTest, SilhouetteTermFollowsTheGapBetweenOutlines) {
       EXPECT_NEAR(mean_px, 0.0, 0.15);
     }
   }
+}
+
+// The silhouette term's distances are searched near each contour vertex,
+// not transformed over the whole image: within the search radius they are
+// OpenCV's exact Euclidean distance transform, interpolated; beyond it they
+// keep their sign and a magnitude of at least the radius. A mask of random
+// discs, some cut by the image border.
+TEST(SilhouetteTest, SignedDistanceNearTheBoundaryMatchesTheDistanceTransform) {
+  const int width = 160, height = 120, radius = 7;
+  cv::Mat mask = cv::Mat::zeros(height, width, CV_8U);
+  std::mt19937 rng(11);
+  std::uniform_real_distribution<double> unit(0.0, 1.0);
+  for (int k = 0; k < 12; ++k) {
+    cv::circle(mask, cv::Point(static_cast<int>(unit(rng) * width), static_cast<int>(unit(rng) * height)),
+               static_cast<int>(3 + unit(rng) * 25), cv::Scalar(255), cv::FILLED);
+  }
+  // The reference: each pixel's distance between centres to the nearest
+  // pixel on the other side, less half a pixel, positive inside.
+  cv::Mat d_in, d_out;
+  cv::distanceTransform(mask > 0, d_in, cv::DIST_L2, cv::DIST_MASK_PRECISE);
+  cv::distanceTransform(mask == 0, d_out, cv::DIST_L2, cv::DIST_MASK_PRECISE);
+  auto reference = [&](int r, int c) {
+    const float in = d_in.at<float>(r, c);
+    return in > 0 ? in - 0.5 : 0.5 - d_out.at<float>(r, c);
+  };
+  int exact = 0, far = 0;
+  for (int k = 0; k < 20000; ++k) {
+    const double x = 0.5 + unit(rng) * (width - 1.001), y = 0.5 + unit(rng) * (height - 1.001);
+    const int c0 = static_cast<int>(std::floor(x - 0.5)), r0 = static_cast<int>(std::floor(y - 0.5));
+    const double fu = x - 0.5 - c0, fv = y - 0.5 - r0;
+    const double p00 = reference(r0, c0), p01 = reference(r0, c0 + 1),
+                 p10 = reference(r0 + 1, c0), p11 = reference(r0 + 1, c0 + 1);
+    const double expected = (1 - fv) * (p00 + fu * (p01 - p00)) + fv * (p10 + fu * (p11 - p10));
+    const double got = SignedDistanceToMaskAt(mask, x, y, radius);
+    const double largest = std::max({std::abs(p00), std::abs(p01), std::abs(p10), std::abs(p11)});
+    if (largest <= radius - 0.5) {
+      ASSERT_NEAR(got, expected, 1e-4) << "at (" << x << ", " << y << ")";
+      ++exact;
+    } else {
+      ASSERT_GT(got * expected, 0) << "at (" << x << ", " << y << ")";
+      ASSERT_GE(std::abs(got), radius - 2.0) << "at (" << x << ", " << y << ")";
+      ++far;
+    }
+  }
+  EXPECT_GT(exact, 5000);
+  EXPECT_GT(far, 1000);
 }
 
 TEST_F(RefinerTest, ScheduleFollowsTheStart) {

@@ -19,12 +19,18 @@
 
 namespace mr {
 
-// Signed distance to the mask boundary in pixels (CV_32F; > 0 inside).
-cv::Mat SignedDistanceToMask(const cv::Mat& mask);
+// Signed distance (pixels, > 0 inside) from image point (x, y) to the
+// boundary of `mask` (CV_8U, inside where > 0): the distance between pixel
+// centres to the nearest pixel on the other side, less half a pixel,
+// interpolated bilinearly (pixel centres at half-integers). Searched up to
+// `radius` pixels: further boundaries give a magnitude of radius + 0.5.
+// (x, y) must lie at least half a pixel inside the image.
+double SignedDistanceToMaskAt(const cv::Mat& mask, double x, double y, int radius);
 
 // Adds, for each contour vertex of `view`, its desired displacement (world
-// units) to `displacement` (#V by 3) and 1 to `count` (#V). Distances are
-// capped at `max_px` pixels.
+// units) to `displacement` (#V by 3) and 1 to `count` (#V). `mask` is the
+// view's observed silhouette (CV_8U, inside where > 0). Distances are capped
+// at `max_px` pixels.
 void AccumulateSilhouetteTerm(const Eigen::MatrixXd& V, const Eigen::MatrixXi& F,
                               const Eigen::MatrixXd& vertex_normals, const PinholeView& view,
                               const RenderBuffers& render, const cv::Mat& signed_distance,
