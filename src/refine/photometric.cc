@@ -3,6 +3,8 @@
 #include <algorithm>
 #include <cmath>
 
+#include <opencv2/imgproc.hpp>
+
 #include "refine/pyramid.h"
 
 #ifdef _OPENMP
@@ -113,37 +115,62 @@ void DataTerm::Add(const DataTerm& other) {
 
 namespace {
 
-// The warp of view j into view i through the mesh: Î_ij, the valid domain,
-// and, when `derivative` is given, per valid pixel the change of Î per unit
-// motion of the surface along its normal, a = ∇I_jᵀ Jπ_j r / (n·r), and the
-// pixel's footprint d / fx (both CV_64F).
+// The bounding box of the pixels of `render` that see the surface (empty if
+// none does).
+cv::Rect ForegroundBox(const RenderBuffers& render) {
+  int top = -1, bottom = -1, left = render.width, right = -1;
+  for (int row = 0; row < render.height; ++row) {
+    const int32_t* ids = render.face_id.data() + static_cast<size_t>(row) * render.width;
+    int first = -1, last = -1;
+    for (int col = 0; col < render.width; ++col) {
+      if (ids[col] < 0) continue;
+      if (first < 0) first = col;
+      last = col;
+    }
+    if (first < 0) continue;
+    if (top < 0) top = row;
+    bottom = row;
+    left = std::min(left, first);
+    right = std::max(right, last);
+  }
+  return top < 0 ? cv::Rect() : cv::Rect(left, top, right - left + 1, bottom - top + 1);
+}
+
+// The warp of view j into view i through the mesh, over the pixels `box` of
+// view i (the maps are box-sized): Î_ij, the valid domain, and, when
+// `derivative` is given, per valid pixel the change of Î per unit motion of
+// the surface along its normal, a = ∇I_jᵀ Jπ_j r / (n·r), and the pixel's
+// footprint d / fx (both CV_64F).
 void WarpImage(const MeshGeometry& mesh, const PinholeView& view_i, const RenderBuffers& render_i,
                const PinholeView& view_j, const RenderBuffers& render_j, const cv::Mat& image_j,
-               const PairTermOptions& options, cv::Mat* predicted, cv::Mat* mask,
-               cv::Mat* derivative, cv::Mat* footprint) {
+               const PairTermOptions& options, const cv::Rect& box, cv::Mat* predicted,
+               cv::Mat* mask, cv::Mat* derivative, cv::Mat* footprint) {
   MR_CHECK(image_j.type() == CV_32F) << "image_j must be CV_32F";
   MR_CHECK(render_i.width == view_i.width && render_i.height == view_i.height);
   MR_CHECK(render_j.width == view_j.width && render_j.height == view_j.height);
-  *predicted = cv::Mat::zeros(view_i.height, view_i.width, CV_64F);
-  *mask = cv::Mat::zeros(view_i.height, view_i.width, CV_8U);
+  MR_CHECK((box & cv::Rect(0, 0, view_i.width, view_i.height)) == box);
+  *predicted = cv::Mat::zeros(box.size(), CV_64F);
+  *mask = cv::Mat::zeros(box.size(), CV_8U);
   if (derivative != nullptr) {
-    *derivative = cv::Mat::zeros(view_i.height, view_i.width, CV_64F);
-    *footprint = cv::Mat::zeros(view_i.height, view_i.width, CV_64F);
+    *derivative = cv::Mat::zeros(box.size(), CV_64F);
+    *footprint = cv::Mat::zeros(box.size(), CV_64F);
   }
 #pragma omp parallel for schedule(dynamic, 8)
-  for (int row = 0; row < view_i.height; ++row) {
+  for (int r = 0; r < box.height; ++r) {
+    const int row = box.y + r;
     PixelWarp warp;
-    for (int col = 0; col < view_i.width; ++col) {
+    for (int c = 0; c < box.width; ++c) {
+      const int col = box.x + c;
       if (!WarpPixel(mesh, view_i, render_i, view_j, render_j, options, row, col, &warp)) continue;
-      mask->at<uint8_t>(row, col) = 255;
+      mask->at<uint8_t>(r, c) = 255;
       Eigen::Vector2d grad_j;
-      predicted->at<double>(row, col) = SampleBilinear(image_j, warp.q.x(), warp.q.y(),
-                                                       derivative != nullptr ? &grad_j : nullptr);
+      predicted->at<double>(r, c) = SampleBilinear(image_j, warp.q.x(), warp.q.y(),
+                                                   derivative != nullptr ? &grad_j : nullptr);
       if (derivative == nullptr) continue;
       const int f = render_i.face_id[static_cast<size_t>(row) * render_i.width + col];
       const Eigen::Vector3d n = mesh.face_normals.row(f);
-      derivative->at<double>(row, col) = grad_j.dot(warp.jacobian_j * warp.ray) / n.dot(warp.ray);
-      footprint->at<double>(row, col) = warp.depth / view_i.fx;
+      derivative->at<double>(r, c) = grad_j.dot(warp.jacobian_j * warp.ray) / n.dot(warp.ray);
+      footprint->at<double>(r, c) = warp.depth / view_i.fx;
     }
   }
 }
@@ -170,8 +197,8 @@ void PredictImage(const MeshGeometry& mesh, const PinholeView& view_i,
                   const RenderBuffers& render_i, const PinholeView& view_j,
                   const RenderBuffers& render_j, const cv::Mat& image_j,
                   const PairTermOptions& options, cv::Mat* predicted, cv::Mat* mask) {
-  WarpImage(mesh, view_i, render_i, view_j, render_j, image_j, options, predicted, mask, nullptr,
-            nullptr);
+  WarpImage(mesh, view_i, render_i, view_j, render_j, image_j, options,
+            cv::Rect(0, 0, view_i.width, view_i.height), predicted, mask, nullptr, nullptr);
 }
 
 DataTermAccumulator::DataTermAccumulator(int num_vertices)
@@ -187,16 +214,28 @@ long DataTermAccumulator::AddPair(const MeshGeometry& mesh, const PinholeView& v
   MR_CHECK(mesh.V->rows() == num_vertices_) << "DataTermAccumulator not sized for the mesh";
   MR_CHECK(static_cast<int>(partial_.size()) >= NumThreads())
       << "DataTermAccumulator used with more threads than it was made for";
+  // Only the pixels around the surface's image are warped and compared.
+  const cv::Rect box = ForegroundBox(render_i);
+  if (box.empty()) return 0;
   cv::Mat predicted, mask, derivative, footprint;
-  WarpImage(mesh, view_i, render_i, view_j, render_j, image_j, options, &predicted, &mask,
+  WarpImage(mesh, view_i, render_i, view_j, render_j, image_j, options, box, &predicted, &mask,
             &derivative, &footprint);
   const long valid = cv::countNonZero(mask);
   if (valid == 0) return 0;
+  // The similarity's Gaussian pads with zeros and every moment it filters is
+  // zero outside the valid pixels, so the maps over their bounding box are
+  // those over the whole image.
+  const cv::Rect roi = cv::boundingRect(mask);
+  predicted = predicted(roi);
+  mask = mask(roi);
+  derivative = derivative(roi);
+  footprint = footprint(roi);
+  const cv::Point origin = box.tl() + roi.tl();  // of the maps, in view i
 
   // Both images in the precision the similarity computes in.
-  cv::Mat observed = image_i;
+  cv::Mat observed = image_i(cv::Rect(origin, roi.size()));
   if (similarity.double_precision) {
-    image_i.convertTo(observed, CV_64F);
+    observed.convertTo(observed, CV_64F);
   } else {
     predicted.convertTo(predicted, CV_32F);
   }
@@ -209,17 +248,16 @@ long DataTermAccumulator::AddPair(const MeshGeometry& mesh, const PinholeView& v
   const bool dp = maps.gradient.depth() == CV_64F;
 
   const Eigen::MatrixXi& F = *mesh.F;
-  const int height = view_i.height, width = view_i.width;
   // Each thread scatters into its own buffer, so no atomics are needed. A
   // static schedule gives every thread the same rows in every run, so the
   // sums (and the refinement) are reproducible for a given thread count.
 #pragma omp parallel for schedule(static)
-  for (int row = 0; row < height; ++row) {
+  for (int row = 0; row < roi.height; ++row) {
     DataTerm& acc = partial_[ThreadIndex()];
     const uint8_t* valid_row = mask.ptr<uint8_t>(row);
-    for (int col = 0; col < width; ++col) {
+    for (int col = 0; col < roi.width; ++col) {
       if (valid_row[col] == 0) continue;
-      const size_t idx = static_cast<size_t>(row) * width + col;
+      const size_t idx = static_cast<size_t>(origin.y + row) * view_i.width + origin.x + col;
       const int f = render_i.face_id[idx];
       const Eigen::Vector3d n = mesh.face_normals.row(f);
       const double a = derivative.at<double>(row, col);
