@@ -210,7 +210,7 @@ long DataTermAccumulator::AddPair(const MeshGeometry& mesh, const PinholeView& v
                                   const RenderBuffers& render_i, const cv::Mat& image_i,
                                   const PinholeView& view_j, const RenderBuffers& render_j,
                                   const cv::Mat& image_j, const SimilarityOptions& similarity,
-                                  const PairTermOptions& options) {
+                                  const PairTermOptions& options, bool with_gradient) {
   MR_CHECK(mesh.V->rows() == num_vertices_) << "DataTermAccumulator not sized for the mesh";
   MR_CHECK(static_cast<int>(partial_.size()) >= NumThreads())
       << "DataTermAccumulator used with more threads than it was made for";
@@ -219,7 +219,7 @@ long DataTermAccumulator::AddPair(const MeshGeometry& mesh, const PinholeView& v
   if (box.empty()) return 0;
   cv::Mat predicted, mask, derivative, footprint;
   WarpImage(mesh, view_i, render_i, view_j, render_j, image_j, options, box, &predicted, &mask,
-            &derivative, &footprint);
+            with_gradient ? &derivative : nullptr, with_gradient ? &footprint : nullptr);
   const long valid = cv::countNonZero(mask);
   if (valid == 0) return 0;
   // The similarity's Gaussian pads with zeros and every moment it filters is
@@ -228,8 +228,10 @@ long DataTermAccumulator::AddPair(const MeshGeometry& mesh, const PinholeView& v
   const cv::Rect roi = cv::boundingRect(mask);
   predicted = predicted(roi);
   mask = mask(roi);
-  derivative = derivative(roi);
-  footprint = footprint(roi);
+  if (with_gradient) {
+    derivative = derivative(roi);
+    footprint = footprint(roi);
+  }
   const cv::Point origin = box.tl() + roi.tl();  // of the maps, in view i
 
   // Both images in the precision the similarity computes in.
@@ -239,12 +241,14 @@ long DataTermAccumulator::AddPair(const MeshGeometry& mesh, const PinholeView& v
   } else {
     predicted.convertTo(predicted, CV_32F);
   }
-  const SimilarityResult maps = ComputeSimilarity(observed, predicted, mask, similarity);
+  const SimilarityResult maps =
+      ComputeSimilarity(observed, predicted, mask, similarity, with_gradient);
   DataTerm& scalars = partial_[0];
   scalars.cost += maps.cost;
   scalars.zncc_sum += maps.zncc_sum;
   scalars.weight_sum += maps.weight_sum;
   scalars.valid_pixels += valid;
+  if (!with_gradient) return valid;
   const bool dp = maps.gradient.depth() == CV_64F;
 
   const Eigen::MatrixXi& F = *mesh.F;

@@ -141,5 +141,31 @@ TEST(PairTerm, AccumulatorEqualsSumOfPairTerms) {
             1e-9 * one_by_one.footprint.norm());
 }
 
+// Without the gradient the accumulator adds the same scalars and nothing
+// else (the final similarity is measured this way).
+TEST(PairTerm, MeasurementAddsTheSameScalars) {
+  TwoViewScene scene;
+  const Eigen::MatrixXd& V = scene.V;
+  const Eigen::MatrixXi& F = scene.F;
+  MeshGeometry mesh{&V, &F, FaceNormals(V, F)};
+  const RenderBuffers ra = RenderCpu(V, F, scene.a), rb = RenderCpu(V, F, scene.b);
+  SimilarityOptions similarity;
+  const PairTermOptions options;
+  DataTermAccumulator full(static_cast<int>(V.rows())), measured(static_cast<int>(V.rows()));
+  const long valid = full.AddPair(mesh, scene.a, ra, scene.image_a, scene.b, rb, scene.image_b,
+                                  similarity, options);
+  EXPECT_EQ(measured.AddPair(mesh, scene.a, ra, scene.image_a, scene.b, rb, scene.image_b,
+                             similarity, options, /*with_gradient=*/false),
+            valid);
+  ASSERT_GT(valid, 100);
+  const DataTerm a = full.Sum(), b = measured.Sum();
+  EXPECT_EQ(a.valid_pixels, b.valid_pixels);
+  EXPECT_DOUBLE_EQ(a.cost, b.cost);
+  EXPECT_DOUBLE_EQ(a.MeanSimilarity(), b.MeanSimilarity());
+  EXPECT_GT(a.gradient.norm(), 0);
+  EXPECT_EQ(b.gradient.norm(), 0);
+  EXPECT_EQ(b.weight.sum(), 0);
+}
+
 }  // namespace
 }  // namespace mr

@@ -177,12 +177,13 @@ double MedianPositive(const Eigen::VectorXd& x) {
   return values.empty() ? 0.0 : Median(values);
 }
 
-// Sums the data term over all ordered pairs of the level. `visit`, if given,
-// is called with each view's render the first time the pass fetches it.
+// Sums the data term over all ordered pairs of the level (only its scalars
+// without `with_gradient`). `visit`, if given, is called with each view's
+// render the first time the pass fetches it.
 DataTerm ComputeDataTerm(const MeshGeometry& mesh, const std::vector<PinholeView>& views,
                          const std::vector<std::pair<int, int>>& pairs, int level,
                          const SimilarityOptions& similarity, const PairTermOptions& pair_options,
-                         RenderCache* renders, ImageCache* images,
+                         RenderCache* renders, ImageCache* images, bool with_gradient,
                          const std::function<void(int, const RenderBuffers&)>& visit = {}) {
   DataTermAccumulator accumulator(static_cast<int>(mesh.V->rows()));
   std::vector<char> visited(views.size(), 0);
@@ -198,7 +199,7 @@ DataTerm ComputeDataTerm(const MeshGeometry& mesh, const std::vector<PinholeView
       const auto render_i = get(i);
       const auto render_j = get(j);
       accumulator.AddPair(mesh, views[i], *render_i, images->Gray(i, level), views[j], *render_j,
-                          images->Gray(j, level), similarity, pair_options);
+                          images->Gray(j, level), similarity, pair_options, with_gradient);
     }
   }
   return accumulator.Sum();
@@ -217,7 +218,8 @@ double FullResolutionSimilarity(const std::vector<PinholeView>& views,
   SimilarityOptions plain = similarity;
   plain.method = "zncc";
   plain.kappa = 0;
-  return ComputeDataTerm(geometry, views, pairs, 0, plain, pair_options, &renders, images)
+  return ComputeDataTerm(geometry, views, pairs, 0, plain, pair_options, &renders, images,
+                         /*with_gradient=*/false)
       .MeanSimilarity();
 }
 
@@ -636,7 +638,8 @@ RefineSummary RefineMesh(const ViewSource& input_source, const RefineOptions& op
       std::function<void(int, const RenderBuffers&)> visit;
       if (use_silhouettes) visit = add_silhouette;
       const DataTerm term = ComputeDataTerm(geometry, views, pairs, level, similarity,
-                                            options.pair, &renders, &images, visit);
+                                            options.pair, &renders, &images,
+                                            /*with_gradient=*/true, visit);
       record.data_seconds = ElapsedSeconds() - t_iter - silhouette_seconds;
       record.mean_similarity = term.MeanSimilarity();
       if (initial_from_first_iteration && global_iteration == 0) {
