@@ -89,8 +89,8 @@ class DataTermAccumulator {
   explicit DataTermAccumulator(int num_vertices);
   // Adds the data term of the ordered pair (i, j). Returns its number of
   // valid pixels. Without `with_gradient` only the scalars (cost,
-  // similarity, weights, valid pixels) are added: a measurement, about half
-  // the work.
+  // similarity, weights, valid pixels) are added, for a measurement: the
+  // similarity's backward pass and the scatter to the vertices are skipped.
   long AddPair(const MeshGeometry& mesh, const PinholeView& view_i, const RenderBuffers& render_i,
                const cv::Mat& image_i, const PinholeView& view_j, const RenderBuffers& render_j,
                const cv::Mat& image_j, const SimilarityOptions& similarity,
