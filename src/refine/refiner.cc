@@ -272,11 +272,15 @@ struct Schedule {
 // flow (Farneback); a surface that is off by d pixels shifts the prediction
 // by about d. Only pixels where the prediction is valid and image i has more
 // than its median gradient count (textureless pixels carry no flow). The
-// median over the pixels of each pair, then the median over pairs.
+// median over the pixels of each pair, then the median over pairs. The flow
+// is computed only around the predicted pixels.
 double MeasureMisalignmentPx(const std::vector<PinholeView>& views,
                              const std::vector<std::pair<int, int>>& pairs,
                              const MeshGeometry& geometry, const PairTermOptions& pair_options,
                              RenderCache* renders, ImageCache* images) {
+  // Beyond the predicted pixels both images are image i: no flow, only the
+  // margin that keeps the flow's window and pyramid away from the crop.
+  constexpr int kMarginPx = 32;
   std::vector<double> per_pair;
   for (const auto& [i, j] : pairs) {
     const auto render_i = renders->Get(i);
@@ -284,7 +288,14 @@ double MeasureMisalignmentPx(const std::vector<PinholeView>& views,
     cv::Mat predicted, mask;
     PredictImage(geometry, views[i], *render_i, views[j], *render_j, images->Gray(j, 0),
                  pair_options, &predicted, &mask);
-    const cv::Mat image_i = images->Gray(i, 0);
+    if (cv::countNonZero(mask) == 0) continue;
+    cv::Rect box = cv::boundingRect(mask);
+    box = cv::Rect(box.x - kMarginPx, box.y - kMarginPx, box.width + 2 * kMarginPx,
+                   box.height + 2 * kMarginPx) &
+          cv::Rect(0, 0, mask.cols, mask.rows);
+    predicted = predicted(box);
+    mask = mask(box);
+    const cv::Mat image_i = images->Gray(i, 0)(box);
     cv::Mat erode;
     cv::erode(mask, erode, cv::getStructuringElement(cv::MORPH_ELLIPSE, cv::Size(9, 9)));
     if (cv::countNonZero(erode) < 500) continue;
