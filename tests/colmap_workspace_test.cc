@@ -35,7 +35,7 @@ class ColmapWorkspace : public ::testing::Test {
       const CommandResult r = RunCommand(
           std::string(MR_BIN_DIR) + "/workspace_synthesizer --output_path " + candidate +
           " --num_views 10 --width 640 --height 480 --colmap_path " + MR_COLMAP_EXECUTABLE +
-          " --num_threads 2");
+          " --num_threads 1 --colmap_timeout_s 300");
       log = r.output.empty() ? "(no output)" : r.output;
       if (r.exit_code == 0) dir = candidate;
     }

@@ -23,14 +23,28 @@ struct CommandResult {
   std::string output;  // stdout and stderr together
 };
 
-inline CommandResult RunCommand(const std::string& command) {
+// Runs `command` through the shell, stdout and stderr captured. After
+// `timeout_s` seconds the command's whole process group is killed (coreutils
+// `timeout`) and the output so far returned with a note, so that a blocked
+// program fails its test with its log rather than at CTest's timeout with
+// nothing to read.
+inline CommandResult RunCommand(const std::string& command, int timeout_s = 450) {
   const std::string log = (std::filesystem::temp_directory_path() /
                            ("mr_command_" + std::to_string(::getpid()) + ".log"))
                               .string();
-  const int status = std::system((command + " > " + log + " 2>&1").c_str());
+  std::string quoted = "'";
+  for (char c : command) quoted += c == '\'' ? std::string("'\\''") : std::string(1, c);
+  quoted += "'";
+  const std::string wrapped =
+      "timeout -k 10 " + std::to_string(timeout_s) + " sh -c " + quoted + " > " + log + " 2>&1";
+  const int status = std::system(wrapped.c_str());
   CommandResult result;
   result.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
   result.output = ReadFileToString(log);
+  if (result.exit_code == 124 || result.exit_code == 137) {
+    result.output += "\n[RunCommand: killed after " + std::to_string(timeout_s) + " s: " +
+                     command + "]\n";
+  }
   std::filesystem::remove(log);
   return result;
 }

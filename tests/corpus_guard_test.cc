@@ -70,7 +70,8 @@ TEST_P(CorpusGuard, DefaultsImproveTheObservedSurface) {
   fs::remove_all(dir);
   const CommandResult synth =
       RunCommand(std::string(MR_BIN_DIR) + "/workspace_synthesizer --output_path " + dir + " " +
-                 flags + " --colmap_path " + MR_COLMAP_EXECUTABLE + " --num_threads 2");
+                 flags + " --colmap_path " + MR_COLMAP_EXECUTABLE +
+                 " --num_threads 1 --colmap_timeout_s 300");
   ASSERT_EQ(synth.exit_code, 0) << synth.output;
   const std::string dense = dir + "/dense";
   const CommandResult r =

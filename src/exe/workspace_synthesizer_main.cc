@@ -94,6 +94,9 @@ int main(int argc, char** argv) {
     options.Add("PoissonMeshing.depth", &o.colmap.poisson_depth,
                 "colmap poisson_mesher octree depth");
     options.Add("num_threads", &o.colmap.num_threads, "colmap threads (-1: all)");
+    options.Add("colmap_timeout_s", &o.colmap.timeout_s,
+                "seconds one colmap run may take before it is killed and the synthesis fails; "
+                "0 = no limit");
     options.Add("Render.platform", &o.renderer.platform, "EGL platform: auto, device, surfaceless");
     options.Add("verbose", &verbose, "verbose logging");
     if (!options.Parse(argc, argv)) return 0;

@@ -1,14 +1,19 @@
 #include "synth/colmap_runner.h"
 
+#include <fcntl.h>
+#include <signal.h>
 #include <sys/stat.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <cerrno>
+#include <chrono>
 #include <cstdlib>
 #include <deque>
 #include <fstream>
 #include <sstream>
 #include <stdexcept>
+#include <thread>
 #include <vector>
 
 #include "util/error.h"
@@ -43,29 +48,81 @@ std::string LogTail(const std::string& path, int lines) {
   return out;
 }
 
-// Runs `args` (already quoted) with QT_QPA_PLATFORM=offscreen, stdout and
-// stderr to `log_path`. Returns the exit status (or -1 if it did not exit).
-int RunLogged(const std::string& executable, const std::vector<std::string>& args,
-              const std::string& log_path) {
-  std::string cmd = "QT_QPA_PLATFORM=offscreen " + ShellQuote(executable);
-  for (const auto& a : args) cmd += " " + ShellQuote(a);
+// How one run of a colmap tool ended.
+struct RunStatus {
+  bool timed_out = false;
+  int exit_code = -1;  // the exit status; -1 if a signal ended it
+};
+
+// Runs `executable args...` with QT_QPA_PLATFORM=offscreen in a process group
+// of its own, stdout and stderr appended to `log_path` (which starts with the
+// command line). After `timeout_s` seconds (0: never) the whole group is
+// killed and the run reported as timed out.
+RunStatus RunLogged(const std::string& executable, const std::vector<std::string>& args,
+                    const std::string& log_path, double timeout_s) {
   {
     std::ofstream log(log_path);
-    log << "$ " << cmd << "\n";
+    log << "$ QT_QPA_PLATFORM=offscreen " << ShellQuote(executable);
+    for (const auto& a : args) log << " " << ShellQuote(a);
+    log << "\n";
   }
-  cmd += " >> " + ShellQuote(log_path) + " 2>&1";
-  MR_LOG(VERBOSE) << "Running: " << cmd;
-  const int status = std::system(cmd.c_str());
-  if (status == -1 || !WIFEXITED(status)) return -1;
-  return WEXITSTATUS(status);
+  std::vector<char*> argv;
+  argv.push_back(const_cast<char*>(executable.c_str()));
+  for (const auto& a : args) argv.push_back(const_cast<char*>(a.c_str()));
+  argv.push_back(nullptr);
+  MR_LOG(VERBOSE) << "Running " << executable << " " << args.front() << " (log: " << log_path
+                  << ")";
+  const pid_t pid = ::fork();
+  if (pid < 0) throw std::runtime_error("fork failed while starting colmap");
+  if (pid == 0) {
+    ::setpgid(0, 0);
+    const int fd = ::open(log_path.c_str(), O_WRONLY | O_APPEND);
+    if (fd < 0) ::_exit(126);
+    ::dup2(fd, 1);
+    ::dup2(fd, 2);
+    ::setenv("QT_QPA_PLATFORM", "offscreen", 1);
+    ::execv(executable.c_str(), argv.data());
+    ::_exit(127);
+  }
+  ::setpgid(pid, pid);  // also here, so the group exists before any kill
+  RunStatus result;
+  const double start = ElapsedSeconds();
+  int status = 0;
+  for (;;) {
+    const pid_t done = ::waitpid(pid, &status, WNOHANG);
+    if (done == pid) break;
+    if (done < 0 && errno != EINTR) return result;
+    if (timeout_s > 0 && ElapsedSeconds() - start > timeout_s) {
+      ::kill(-pid, SIGKILL);
+      ::waitpid(pid, &status, 0);
+      result.timed_out = true;
+      return result;
+    }
+    std::this_thread::sleep_for(std::chrono::milliseconds(20));
+  }
+  if (WIFEXITED(status)) result.exit_code = WEXITSTATUS(status);
+  return result;
 }
 
+// Runs a colmap tool; throws with the log's tail if it fails or does not end
+// within options.timeout_s.
 void RunOrThrow(const std::string& executable, const std::string& tool,
-                const std::vector<std::string>& args, const std::string& log_path) {
-  const int code = RunLogged(executable, args, log_path);
-  if (code != 0) {
-    throw std::runtime_error("colmap " + tool + " failed (exit status " + std::to_string(code) +
-                             "); see " + log_path + ". Last lines:\n" + LogTail(log_path, 15));
+                const std::vector<std::string>& args, const std::string& log_path,
+                const ColmapRunOptions& options) {
+  const RunStatus status = RunLogged(executable, args, log_path, options.timeout_s);
+  if (status.timed_out) {
+    std::ostringstream message;
+    message << "colmap " << tool << " did not end within " << options.timeout_s
+            << " s (--colmap_timeout_s) and was killed; see " << log_path
+            << ". Several OpenMP programs sharing the cores can slow it down tenfold; "
+            << "try --num_threads 1. Last lines:\n"
+            << LogTail(log_path, 15);
+    throw std::runtime_error(message.str());
+  }
+  if (status.exit_code != 0) {
+    throw std::runtime_error("colmap " + tool + " failed (exit status " +
+                             std::to_string(status.exit_code) + "); see " + log_path +
+                             ". Last lines:\n" + LogTail(log_path, 15));
   }
 }
 
@@ -86,6 +143,10 @@ bool ColmapRunOptions::Check() const {
   if (poisson_depth < 4 || poisson_depth > 16) {
     MR_THROW_INPUT << "ColmapRunOptions::poisson_depth = " << poisson_depth
                    << ". Violated constraint: 4 <= poisson_depth <= 16";
+  }
+  if (!(timeout_s >= 0 && timeout_s <= 1e6)) {
+    MR_THROW_INPUT << "ColmapRunOptions::timeout_s = " << timeout_s
+                   << ". Violated constraint: 0 <= timeout_s <= 1e6";
   }
   if (num_threads == 0 || num_threads < -1) {
     MR_THROW_INPUT << "ColmapRunOptions::num_threads = " << num_threads
@@ -159,7 +220,7 @@ ColmapRunSummary RunColmapFusionAndPoisson(const std::string& dense_path,
               "--input_type", "geometric", "--output_path", fused,
               "--StereoFusion.min_num_pixels", std::to_string(options.fusion_min_num_pixels),
               "--StereoFusion.num_threads", threads, "--log_to_stderr", "1"},
-             fusion_log);
+             fusion_log, options);
   summary.fusion_seconds = ElapsedSeconds() - t0;
   if (!ExistsFile(fused)) {
     throw std::runtime_error("colmap stereo_fusion wrote no " + fused + "; see " + fusion_log +
@@ -192,7 +253,7 @@ ColmapRunSummary RunColmapFusionAndPoisson(const std::string& dense_path,
                 "--PoissonMeshing.trim", trim.str(), "--PoissonMeshing.depth",
                 std::to_string(options.poisson_depth), "--PoissonMeshing.num_threads", threads,
                 "--log_to_stderr", "1"},
-               poisson_log);
+               poisson_log, options);
     if (!ExistsFile(mesh)) {
       throw std::runtime_error("colmap poisson_mesher wrote no " + mesh + "; see " +
                                poisson_log + ". Last lines:\n" + LogTail(poisson_log, 15));

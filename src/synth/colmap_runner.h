@@ -25,6 +25,11 @@ struct ColmapRunOptions {
   int poisson_depth = 8;
   // Threads for both stages (-1: all). Range -1 or >= 1.
   int num_threads = -1;
+  // Seconds one colmap run may take before it is killed and the run fails
+  // with its log; 0 = no limit. Two colmap processes of 2 OpenMP threads each
+  // on 2 cores made poisson_mesher 13x slower (3.4 -> 43.6 s), so test suites
+  // that run several at once set a limit (and num_threads 1). Range [0, 1e6].
+  double timeout_s = 0;
 
   bool Check() const;
 };

@@ -1,5 +1,7 @@
 #include "synth/synthesizer.h"
 
+#include <signal.h>
+#include <sys/stat.h>
 #include <unistd.h>
 
 #include <algorithm>
@@ -20,6 +22,7 @@
 #include "synth/synth_test_util.h"
 #include "util/error.h"
 #include "util/file.h"
+#include "util/logging.h"
 
 namespace mr {
 namespace {
@@ -393,6 +396,52 @@ TEST(ColmapRunner, HelpersAndFailureMessage) {
   EXPECT_THROW(RunColmapFusionAndPoisson(dir, JoinPaths(dir, "logs"), options), InputError);
 }
 
+// A colmap run that does not end within timeout_s is killed, with the
+// processes it started, and the synthesis fails naming the limit. `fake`
+// stands in for colmap: it writes a one-point fused.ply and then sleeps in a
+// child process of its own.
+TEST(ColmapRunner, RunPastTheTimeoutIsKilled) {
+  const std::string dir = FreshDir("runner_timeout");
+  CreateDirIfNotExists(dir);
+  const std::string fake = JoinPaths(dir, "fake_colmap.sh");
+  const std::string pid_file = JoinPaths(dir, "sleeper.pid");
+  {
+    std::ofstream out(fake);
+    out << "#!/bin/sh\n"
+        << "printf 'ply\\nformat ascii 1.0\\nelement vertex 1\\nproperty float x\\n"
+           "end_header\\n0\\n' > '" << JoinPaths(dir, "fused.ply") << "'\n"
+        << "echo 'Writing output'\n"
+        << "sleep 1000 &\n"
+        << "echo $! > '" << pid_file << "'\n"
+        << "wait\n";
+  }
+  ASSERT_EQ(::chmod(fake.c_str(), 0755), 0);
+  ColmapRunOptions options;
+  options.colmap_path = fake;
+  options.timeout_s = 5;  // time for the fake to reach its sleep on a loaded machine
+  const double t0 = ElapsedSeconds();
+  try {
+    RunColmapFusionAndPoisson(dir, JoinPaths(dir, "logs"), options);
+    FAIL() << "expected a failure";
+  } catch (const std::runtime_error& e) {
+    const std::string what = e.what();
+    EXPECT_NE(what.find("stereo_fusion did not end within 5 s"), std::string::npos) << what;
+    EXPECT_NE(what.find("Writing output"), std::string::npos) << what;
+  }
+  EXPECT_LT(ElapsedSeconds() - t0, 60);
+  ASSERT_TRUE(ExistsFile(pid_file)) << "the fake did not reach its sleep in 5 s";
+  const int sleeper = std::stoi(ReadFileToString(pid_file));
+  // SIGKILL'd with its group; reaped by init shortly after.
+  bool gone = false;
+  for (int i = 0; i < 100 && !gone; ++i) {
+    gone = ::kill(sleeper, 0) != 0;
+    if (!gone) ::usleep(20000);
+  }
+  EXPECT_TRUE(gone) << "the fake's child " << sleeper << " outlived the timeout";
+  options.timeout_s = -1;
+  EXPECT_THROW(options.Check(), InputError);
+}
+
 // The whole path with the real colmap: stereo_fusion + poisson_mesher give a
 // non-empty mesh close to the ground truth.
 TEST(Synthesizer, EndToEndWithColmap) {
@@ -406,7 +455,8 @@ TEST(Synthesizer, EndToEndWithColmap) {
   options.run_colmap = true;
   options.colmap.colmap_path = colmap;
   options.colmap.poisson_depth = 8;
-  options.colmap.num_threads = 2;
+  options.colmap.num_threads = 1;  // see ColmapRunOptions::timeout_s
+  options.colmap.timeout_s = 300;
   const SynthesizerSummary summary = SynthesizeWorkspace(options);
   ASSERT_TRUE(summary.ran_colmap);
   EXPECT_GT(summary.colmap.fused_points, 1000);
