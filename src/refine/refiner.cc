@@ -178,19 +178,17 @@ double MedianPositive(const Eigen::VectorXd& x) {
 }
 
 // Sums the data term over all ordered pairs of the level (only its scalars
-// without `with_gradient`). `visit`, if given, is called with each view's
-// render the first time the pass fetches it.
+// without `with_gradient`). `visit`, if given, is called with a view's render
+// each time the pass fetches it (twice per pair).
 DataTerm ComputeDataTerm(const MeshGeometry& mesh, const std::vector<PinholeView>& views,
                          const std::vector<std::pair<int, int>>& pairs, int level,
                          const SimilarityOptions& similarity, const PairTermOptions& pair_options,
                          RenderCache* renders, ImageCache* images, bool with_gradient,
                          const std::function<void(int, const RenderBuffers&)>& visit = {}) {
   DataTermAccumulator accumulator(static_cast<int>(mesh.V->rows()));
-  std::vector<char> visited(views.size(), 0);
   auto get = [&](int i) {
     auto render = renders->Get(i);
-    if (visit && !visited[i]) visit(i, *render);
-    visited[i] = 1;
+    if (visit) visit(i, *render);
     return render;
   };
   for (const auto& [a, b] : pairs) {
@@ -637,6 +635,7 @@ RefineSummary RefineMesh(const ViewSource& input_source, const RefineOptions& op
       double silhouette_seconds = 0;
       const Eigen::MatrixXd N = use_silhouettes ? VertexNormals(V, F) : Eigen::MatrixXd();
       auto add_silhouette = [&](int i, const RenderBuffers& render) {
+        if (silhouette_done[i]) return;
         const double t0 = ElapsedSeconds();
         silhouette_done[i] = 1;
         const cv::Mat mask = images.Mask(i, level);

@@ -14,8 +14,9 @@ namespace {
 // Signed distance (pixels, > 0 inside) from pixel (row, col) to the boundary
 // of the pixel set `inside`, the distance between pixel centres to the
 // nearest pixel of the other set less half a pixel, searched only up to
-// `radius` pixels away: where the other set is further, the distance is
-// reported as radius + 1 (a lower bound). The rings of pixels at growing
+// `radius` pixels away: where none lies within, the distance is reported as
+// radius + 1 (the true one is larger than radius; callers choose a radius
+// beyond the distances they use). The rings of pixels at growing
 // Chebyshev distance k are searched until k^2 reaches the best squared
 // distance found, so a pixel near the boundary costs a few dozen tests.
 template <typename Inside>
