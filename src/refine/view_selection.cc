@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <deque>
 #include <set>
 
 #include <Eigen/Geometry>
@@ -151,11 +152,58 @@ double BestViewCoverage(const std::vector<PinholeView>& views, const Eigen::Matr
 }
 
 std::vector<std::pair<int, int>> NeighborPairs(const std::vector<std::vector<int>>& neighbors) {
-  std::set<std::pair<int, int>> pairs;
-  for (int i = 0; i < static_cast<int>(neighbors.size()); ++i) {
-    for (int j : neighbors[i]) pairs.emplace(std::min(i, j), std::max(i, j));
+  const int n = static_cast<int>(neighbors.size());
+  std::set<std::pair<int, int>> unique;
+  for (int i = 0; i < n; ++i) {
+    for (int j : neighbors[i]) {
+      if (j != i) unique.emplace(std::min(i, j), std::max(i, j));
+    }
   }
-  return {pairs.begin(), pairs.end()};
+  std::vector<std::vector<int>> adjacent(n);
+  for (const auto& [a, b] : unique) {
+    adjacent[a].push_back(b);
+    adjacent[b].push_back(a);
+  }
+  // Cuthill-McKee: breadth first from a view of least degree, each view's
+  // unnumbered neighbours in order of degree, one component after another.
+  // Neighbouring views get nearby numbers whatever the input's numbering.
+  std::vector<int> position(n, -1);
+  int next = 0;
+  auto by_degree = [&](int a, int b) {
+    return adjacent[a].size() != adjacent[b].size() ? adjacent[a].size() < adjacent[b].size()
+                                                    : a < b;
+  };
+  while (next < n) {
+    int start = -1;
+    for (int v = 0; v < n; ++v) {
+      if (position[v] < 0 && (start < 0 || by_degree(v, start))) start = v;
+    }
+    std::deque<int> queue = {start};
+    position[start] = next++;
+    while (!queue.empty()) {
+      const int v = queue.front();
+      queue.pop_front();
+      std::vector<int> fresh;
+      for (int w : adjacent[v]) {
+        if (position[w] < 0) fresh.push_back(w);
+      }
+      std::sort(fresh.begin(), fresh.end(), by_degree);
+      for (int w : fresh) {
+        position[w] = next++;
+        queue.push_back(w);
+      }
+    }
+  }
+  // By the later view's number, then the earlier's: a view's pairs come
+  // while its neighbours, numbered shortly before it, are still cached.
+  std::vector<std::pair<int, int>> pairs(unique.begin(), unique.end());
+  auto key = [&](const std::pair<int, int>& p) {
+    const int a = position[p.first], b = position[p.second];
+    return std::make_pair(std::max(a, b), std::min(a, b));
+  };
+  std::sort(pairs.begin(), pairs.end(),
+            [&](const auto& x, const auto& y) { return key(x) < key(y); });
+  return pairs;
 }
 
 }  // namespace mr

@@ -34,7 +34,13 @@ std::vector<std::vector<int>> SelectNeighbors(const std::vector<PinholeView>& vi
                                               const Eigen::MatrixXd& N,
                                               const ViewSelectionOptions& options);
 
-// Unordered pairs {i, j} (i < j) from the neighbour lists, sorted.
+// Unordered pairs {i, j} (i < j) from the neighbour lists, in an order
+// that a small cache of per-view data (renders, images) serves well: the
+// views are renumbered by Cuthill-McKee, so that neighbours get nearby
+// numbers, and the pairs sorted by their later view, then their earlier
+// one. An LRU cache holding more views than the renumbered pair graph's
+// bandwidth then loads every view once per pass over the pairs
+// (lexicographic order on a hemisphere of 100 views: 175 renders per pass).
 std::vector<std::pair<int, int>> NeighborPairs(const std::vector<std::vector<int>>& neighbors);
 
 // Median pixel footprint (world units per pixel) of the vertices V (with
