@@ -6,7 +6,9 @@
 #      faces (COLMAP's Poisson mesh remeshed to 0.7-pixel edges by
 #      mesh_refiner itself, with no iterations: Poisson at depth 10 gives only
 #      365k faces from the example's 84k fused points);
-#   d) 12 views of 6000x4000 (24 MP, rendered without supersampling);
+#   d) 12 views of 6000x4000 (24 MP, rendered without supersampling; COLMAP
+#      fuses their depth maps at 2000 px, the full-size fusion of 12 x 24 MP
+#      being what a real pipeline would run at its own max_image_size);
 # each made by workspace_synthesizer (real colmap fusion + Poisson), timed
 # with /usr/bin/time (wall seconds, peak KB) and evaluated on the observed
 # surface. One line per case: the refiner's working resolution and faces,
@@ -30,7 +32,7 @@ synth_flags() {
     a) echo "--num_views 40 --width 1920 --height 1440" ;;
     b) echo "--num_views 100 --width 1600 --height 1200 --layout hemisphere" ;;
     c) echo "--num_views 16" ;;
-    d) echo "--num_views 12 --width 6000 --height 4000 --supersample 1" ;;
+    d) echo "--num_views 12 --width 6000 --height 4000 --supersample 1 --StereoFusion.max_image_size 2000" ;;
     *) echo "unknown case: $1 (a, b, c or d)" >&2; exit 2 ;;
   esac
 }

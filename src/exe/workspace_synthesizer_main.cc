@@ -89,6 +89,9 @@ int main(int argc, char** argv) {
     options.Add("colmap_path", &o.colmap.colmap_path, "colmap executable (path or name on PATH)");
     options.Add("StereoFusion.min_num_pixels", &o.colmap.fusion_min_num_pixels,
                 "colmap stereo_fusion min_num_pixels");
+    options.Add("StereoFusion.max_image_size", &o.colmap.fusion_max_image_size,
+                "colmap stereo_fusion max_image_size: longest side at which the depth maps are "
+                "fused (-1: their own size)");
     options.Add("PoissonMeshing.trim", &o.colmap.poisson_trim,
                 "colmap poisson_mesher trim (retried lower if the mesh comes out empty)");
     options.Add("PoissonMeshing.depth", &o.colmap.poisson_depth,

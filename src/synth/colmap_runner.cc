@@ -136,6 +136,10 @@ bool ColmapRunOptions::Check() const {
     MR_THROW_INPUT << "ColmapRunOptions::fusion_min_num_pixels = " << fusion_min_num_pixels
                    << ". Violated constraint: 1 <= fusion_min_num_pixels <= 100";
   }
+  if (fusion_max_image_size != -1 && fusion_max_image_size < 100) {
+    MR_THROW_INPUT << "ColmapRunOptions::fusion_max_image_size = " << fusion_max_image_size
+                   << ". Violated constraint: fusion_max_image_size == -1 or >= 100";
+  }
   if (!(poisson_trim >= 0 && poisson_trim <= 20)) {
     MR_THROW_INPUT << "ColmapRunOptions::poisson_trim = " << poisson_trim
                    << ". Violated constraint: 0 <= poisson_trim <= 20";
@@ -219,6 +223,7 @@ ColmapRunSummary RunColmapFusionAndPoisson(const std::string& dense_path,
              {"stereo_fusion", "--workspace_path", dense_path, "--workspace_format", "COLMAP",
               "--input_type", "geometric", "--output_path", fused,
               "--StereoFusion.min_num_pixels", std::to_string(options.fusion_min_num_pixels),
+              "--StereoFusion.max_image_size", std::to_string(options.fusion_max_image_size),
               "--StereoFusion.num_threads", threads, "--log_to_stderr", "1"},
              fusion_log, options);
   summary.fusion_seconds = ElapsedSeconds() - t0;

@@ -13,6 +13,11 @@ struct ColmapRunOptions {
   // --StereoFusion.min_num_pixels (COLMAP's default 5 is too strict for
   // sparse rings). Range [1, 100].
   int fusion_min_num_pixels = 3;
+  // --StereoFusion.max_image_size: the longest side at which colmap fuses
+  // the depth maps (-1: their own size). For workspaces of tens of
+  // megapixels per image, whose full-size fusion would hold every depth,
+  // normal and colour map at once. Range -1 or >= 100.
+  int fusion_max_image_size = -1;
   // --PoissonMeshing.trim. COLMAP's default 10 can delete every vertex of a
   // small cloud; if the mesh comes out empty the run is retried with lower
   // trims (logged). Range [0, 20].

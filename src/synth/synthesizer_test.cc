@@ -54,6 +54,11 @@ TEST(SynthesizerOptions, DefaultsAreValid) {
   options.output_path = "/tmp/x";  // the one required field
   EXPECT_TRUE(options.Check());
   EXPECT_TRUE(ColmapRunOptions().Check());
+  ColmapRunOptions fusion;
+  fusion.fusion_max_image_size = 2000;
+  EXPECT_TRUE(fusion.Check());
+  fusion.fusion_max_image_size = 50;
+  EXPECT_THROW(fusion.Check(), InputError);
 }
 
 TEST(SynthesizerOptions, RejectsBadValues) {
