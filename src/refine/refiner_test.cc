@@ -125,15 +125,19 @@ TEST_F(RefinerTest, GroundTruthStaysGroundTruth) {
       << "relief RMS " << relief_before << " -> " << relief_after;
 }
 
+// The bumpy sphere (V, F) that the test scene shows, and the smooth sphere
+// (V0, F0) to start from: the relief must be recovered from the images.
+void MakeBumpyAndSmoothSpheres(Eigen::MatrixXd* V, Eigen::MatrixXi* F, Eigen::MatrixXd* V0,
+                               Eigen::MatrixXi* F0) {
+  MakeBumpySphere(5, 0.06, V, F);
+  MakeIcosphere(4, 1.0, V0, F0);
+}
+
 TEST_F(RefinerTest, NoisyMeshGetsCloserToGroundTruth) {
-  Eigen::MatrixXd V;
-  Eigen::MatrixXi F;
-  MakeBumpySphere(5, 0.06, &V, &F);
+  Eigen::MatrixXd V, V0;
+  Eigen::MatrixXi F, F0;
+  MakeBumpyAndSmoothSpheres(&V, &F, &V0, &F0);
   const InMemoryViewSource source = MakeTestScene(V, F, {}, {}, renderer_);
-  // Start from a smooth sphere: the relief must be recovered from the images.
-  Eigen::MatrixXd V0;
-  Eigen::MatrixXi F0;
-  MakeIcosphere(4, 1.0, &V0, &F0);
   TriangleMesh mesh;
   mesh.V = V0;
   mesh.F = F0;
@@ -152,6 +156,44 @@ TEST_F(RefinerTest, NoisyMeshGetsCloserToGroundTruth) {
   EXPECT_NE(summary.FullReport().find("  time: setup "), std::string::npos);
 }
 
+// --Refine.pair_halves_min_views: the middle iterations of each level take
+// alternate halves of the pairs, the first and last two all of them, and the
+// relief is recovered as well as with all pairs in every iteration.
+TEST_F(RefinerTest, PairHalvesInTheMiddleIterations) {
+  Eigen::MatrixXd V, V0;
+  Eigen::MatrixXi F, F0;
+  MakeBumpyAndSmoothSpheres(&V, &F, &V0, &F0);
+  const InMemoryViewSource source = MakeTestScene(V, F, {}, {}, renderer_);
+  RefineOptions options = FastOptions();
+  options.num_levels = 1;
+  RefineOptions halves = options;
+  halves.pair_halves_min_views = source.NumViews();
+  options.pair_halves_min_views = source.NumViews() + 1;  // off
+  EvaluationResult result[2];
+  for (int k = 0; k < 2; ++k) {
+    TriangleMesh mesh;
+    mesh.V = V0;
+    mesh.F = F0;
+    const RefineSummary summary = RefineMesh(source, k ? halves : options, &mesh, renderer_);
+    result[k] = Evaluate(mesh.V, mesh.F, V, F);
+    EXPECT_EQ(summary.FullReport().find("h: the similarity over half") != std::string::npos,
+              k == 1);
+    ASSERT_EQ(summary.iterations.size(), 6u);
+    for (int it = 0; it < 6; ++it) {
+      const bool all = k == 0 || it == 0 || it >= 4;
+      if (all) {
+        EXPECT_EQ(summary.iterations[it].num_pairs, summary.num_pairs) << it;
+      } else {
+        EXPECT_LT(summary.iterations[it].num_pairs, summary.num_pairs) << it;
+        EXPECT_GE(summary.iterations[it].num_pairs, summary.num_pairs / 2 - 1) << it;
+      }
+    }
+  }
+  RecordProperty("accuracy90_all_pairs", std::to_string(result[0].accuracy90));
+  RecordProperty("accuracy90_halves", std::to_string(result[1].accuracy90));
+  EXPECT_LT(result[1].accuracy90, 1.1 * result[0].accuracy90);
+  EXPECT_LT(result[1].normal_deg, 1.1 * result[0].normal_deg);
+}
 
 // --Refine.max_image_size: images and cameras scaled down together. The same
 // scene rendered at twice the size and refined at max_image_size 160 ends

@@ -206,4 +206,59 @@ std::vector<std::pair<int, int>> NeighborPairs(const std::vector<std::vector<int
   return pairs;
 }
 
+std::vector<std::vector<std::pair<int, int>>> SplitPairsCoveringViews(
+    const std::vector<std::pair<int, int>>& pairs, int num_groups) {
+  MR_CHECK(num_groups >= 1);
+  int num_views = 0;
+  for (const auto& [a, b] : pairs) num_views = std::max({num_views, a + 1, b + 1});
+  // count[g][v]: pairs of view v in group g.
+  std::vector<std::vector<int>> count(num_groups, std::vector<int>(num_views, 0));
+  std::vector<std::vector<int>> pairs_of(num_views);
+  std::vector<int> group_of(pairs.size()), group_size(num_groups, 0);
+  for (size_t k = 0; k < pairs.size(); ++k) {
+    const auto [a, b] = pairs[k];
+    pairs_of[a].push_back(static_cast<int>(k));
+    pairs_of[b].push_back(static_cast<int>(k));
+    // The group that gains the most views from the pair, then the smallest.
+    int best = 0, best_gain = -1;
+    for (int g = 0; g < num_groups; ++g) {
+      const int gain = (count[g][a] == 0) + (count[g][b] == 0);
+      if (gain > best_gain || (gain == best_gain && group_size[g] < group_size[best])) {
+        best = g;
+        best_gain = gain;
+      }
+    }
+    group_of[k] = best;
+    ++group_size[best];
+    ++count[best][a];
+    ++count[best][b];
+  }
+  // Repair what the greedy pass left: a view missing from group g takes one
+  // of its pairs from a group where both of that pair's views have another.
+  for (int sweep = 0; sweep < 4; ++sweep) {
+    bool moved = false;
+    for (int v = 0; v < num_views; ++v) {
+      for (int g = 0; g < num_groups; ++g) {
+        if (count[g][v] > 0 || static_cast<int>(pairs_of[v].size()) < num_groups) continue;
+        for (const int k : pairs_of[v]) {
+          const int h = group_of[k];
+          const auto [a, b] = pairs[k];
+          if (count[h][a] < 2 || count[h][b] < 2) continue;
+          --count[h][a];
+          --count[h][b];
+          ++count[g][a];
+          ++count[g][b];
+          group_of[k] = g;
+          moved = true;
+          break;
+        }
+      }
+    }
+    if (!moved) break;
+  }
+  std::vector<std::vector<std::pair<int, int>>> groups(num_groups);
+  for (size_t k = 0; k < pairs.size(); ++k) groups[group_of[k]].push_back(pairs[k]);
+  return groups;
+}
+
 }  // namespace mr

@@ -43,6 +43,15 @@ std::vector<std::vector<int>> SelectNeighbors(const std::vector<PinholeView>& vi
 // (lexicographic order on a hemisphere of 100 views: 175 renders per pass).
 std::vector<std::pair<int, int>> NeighborPairs(const std::vector<std::vector<int>>& neighbors);
 
+// `pairs` split into `num_groups` (>= 1) groups, each in the pairs' order,
+// such that every group covers as many views as it can: each pair goes to
+// the group in which it covers the most views not yet covered there (ties to
+// the smallest group), then a view missing from a group takes one of its
+// pairs from a group where both views of that pair have another. On 100
+// hemisphere views with 3 neighbours each, both halves cover every view.
+std::vector<std::vector<std::pair<int, int>>> SplitPairsCoveringViews(
+    const std::vector<std::pair<int, int>>& pairs, int num_groups);
+
 // Median pixel footprint (world units per pixel) of the vertices V (with
 // normals N) over the views that see them (facing the camera, inside the
 // image); 0 if no view sees any vertex.

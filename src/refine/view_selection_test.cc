@@ -102,5 +102,49 @@ TEST(NeighborPairs, SeveralComponentsAndNoNeighbours) {
   EXPECT_TRUE(NeighborPairs({{}, {}}).empty());
 }
 
+TEST(SplitPairsCoveringViews, TwoHalvesEachCoverEveryView) {
+  const int n = 100;
+  const auto pairs = NeighborPairs(HemisphereNeighbors(n, 3, 7));
+  const auto groups = SplitPairsCoveringViews(pairs, 2);
+  ASSERT_EQ(groups.size(), 2u);
+  // Every pair in exactly one group, each group in the pairs' own order.
+  std::multiset<std::pair<int, int>> all;
+  for (const auto& group : groups) {
+    all.insert(group.begin(), group.end());
+    for (size_t k = 1; k < group.size(); ++k) {
+      const auto at = [&](size_t m) {
+        return std::find(pairs.begin(), pairs.end(), group[m]) - pairs.begin();
+      };
+      EXPECT_LT(at(k - 1), at(k));
+    }
+  }
+  const std::multiset<std::pair<int, int>> expected(pairs.begin(), pairs.end());
+  EXPECT_EQ(all, expected);
+  // Each half holds about half the pairs and every view in 2 or more pairs.
+  std::vector<int> pairs_of(n, 0);
+  for (const auto& [a, b] : pairs) {
+    ++pairs_of[a];
+    ++pairs_of[b];
+  }
+  for (const auto& group : groups) {
+    EXPECT_NEAR(static_cast<double>(group.size()), pairs.size() / 2.0, pairs.size() / 10.0);
+    std::set<int> covered;
+    for (const auto& [a, b] : group) {
+      covered.insert(a);
+      covered.insert(b);
+    }
+    for (int v = 0; v < n; ++v) {
+      if (pairs_of[v] >= 2) {
+        EXPECT_TRUE(covered.count(v)) << "view " << v;
+      }
+    }
+  }
+  // One group: the pairs as they were; no pairs: empty groups.
+  EXPECT_EQ(SplitPairsCoveringViews(pairs, 1)[0], pairs);
+  const auto none = SplitPairsCoveringViews({}, 3);
+  ASSERT_EQ(none.size(), 3u);
+  EXPECT_TRUE(none[0].empty() && none[1].empty() && none[2].empty());
+}
+
 }  // namespace
 }  // namespace mr
