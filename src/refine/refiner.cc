@@ -402,6 +402,13 @@ std::string FormatSeconds(double s) {
 
 }  // namespace
 
+double MeanResetFraction(const std::vector<int>& resets, int num_vertices) {
+  if (resets.empty() || num_vertices <= 0) return 0.0;
+  double sum = 0;
+  for (const int r : resets) sum += r;
+  return sum / (static_cast<double>(resets.size()) * num_vertices);
+}
+
 bool RefineOptions::Check() const {
   auto fail = [](const std::string& field, const std::string& value, const std::string& bound) {
     MR_THROW_INPUT << "RefineOptions::" << field << " = " << value
@@ -818,6 +825,7 @@ RefineSummary RefineMesh(const ViewSource& input_source, const RefineOptions& op
         const UndoSelfIntersectionsSummary undone = guard->Undo(V_before, &V);
         summary.self_intersections_undone += undone.initial_pairs;
         summary.vertices_reset += undone.reset_vertices;
+        record.vertices_reset = undone.reset_vertices;
         if (undone.initial_pairs > 0) {
           MR_LOG(INFO) << "UndoSelfIntersections: " << undone.BriefReport();
         }
@@ -850,21 +858,36 @@ RefineSummary RefineMesh(const ViewSource& input_source, const RefineOptions& op
                    << FormatSeconds(eta);
       summary.iterations.push_back(record);
     }
-    // A level whose similarity fell well below its best ends on that best:
-    // the regulariser and the guards overrode the images (an open shell
-    // wrapped by Poisson in a closed blob: docs/results.md).
+    // A level whose similarity fell well below its best while the
+    // self-intersection guard was resetting much of the mesh ends on that
+    // best: the guard, not the images, drove it (an open shell wrapped by
+    // Poisson in a closed blob: docs/results.md).
     const int best = BestIterateToKeep(level_similarities, options.best_iterate_giveback);
-    if (best >= 0) {
-      const int run = static_cast<int>(std::count_if(
-          summary.iterations.begin(), summary.iterations.end(),
-          [&](const RefineIteration& r) { return r.level == level; }));
-      const int dropped = run - best_iteration;
+    std::vector<int> resets_after_best;
+    for (const auto& r : summary.iterations) {
+      if (r.level == level && r.iteration >= best_iteration) {
+        resets_after_best.push_back(r.vertices_reset);
+      }
+    }
+    const double reset_fraction = MeanResetFraction(resets_after_best, static_cast<int>(V.rows()));
+    if (best >= 0 && !(reset_fraction > kGuardOverrideFraction)) {
+      MR_LOG(INFO) << "Level " << level << ": the similarity fell from " << best_similarity
+                   << " (after " << best_iteration << " iterations) to "
+                   << level_similarities.back() << ", but the self-intersection guard reset only "
+                   << 100 * reset_fraction << " % of the vertices per iteration after it ("
+                   << 100 * kGuardOverrideFraction
+                   << " % marks a level that the guard drove): the last iterate is kept";
+    }
+    if (best >= 0 && reset_fraction > kGuardOverrideFraction) {
+      const int dropped = static_cast<int>(resets_after_best.size());
       MR_LOG(INFO) << "Level " << level << " ends on the mesh after " << best_iteration
                    << " iterations: the similarity fell from " << best_similarity << " to "
                    << level_similarities.back() << ", more than "
                    << options.best_iterate_giveback << " of the gain "
-                   << best_similarity - level_similarities.front() << " up to it ("
-                   << dropped << " iterations dropped)";
+                   << best_similarity - level_similarities.front()
+                   << " up to it, while the self-intersection guard reset "
+                   << 100 * reset_fraction << " % of the vertices per iteration (" << dropped
+                   << " iterations dropped)";
       V = V_best;
       guard_verified_clean = false;
       ++summary.levels_ended_on_best;
@@ -923,7 +946,8 @@ void RegisterRefineOptions(OptionManager* o, RefineOptions* r) {
          "a level ends when the mean ZNCC rose by less than this in one iteration (0: never)");
   o->Add("Refine.best_iterate_giveback", &r->best_iterate_giveback,
          "a level ends on its best iterate (mean similarity) when the last has fallen from it by "
-         "more than this fraction of the level's gain up to it, [0, 1]");
+         "more than this fraction of the level's gain up to it and the self-intersection guard "
+         "reset over 10 % of the vertices per iteration after it, [0, 1]");
   o->Add("Refine.pair_halves_min_views", &r->pair_halves_min_views,
          "from this many views on, a level's iterations but its first and last two use "
          "alternate halves of the view pairs (0: all pairs always)");
