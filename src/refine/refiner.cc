@@ -299,8 +299,8 @@ double MeasureMisalignmentPx(const std::vector<PinholeView>& views,
   constexpr int kMarginPx = 32;
   constexpr size_t kMaxPairs = 64;
   std::vector<double> per_pair;
-  const size_t stride = (pairs.size() + kMaxPairs - 1) / kMaxPairs;
-  for (size_t k = 0; k < pairs.size(); k += std::max<size_t>(1, stride)) {
+  const size_t stride = std::max<size_t>(1, (pairs.size() + kMaxPairs - 1) / kMaxPairs);
+  for (size_t k = 0; k < pairs.size(); k += stride) {
     const auto& [i, j] = pairs[k];
     const auto render_i = renders->Get(i);
     const auto render_j = renders->Get(j);
@@ -498,8 +498,9 @@ std::string RefineSummary::FullReport() const {
     any_half = any_half || half;
     out << "  " << std::setw(5) << it.level << std::setw(5) << it.iteration << std::setw(7)
         << it.faces << "  " << std::fixed << std::setprecision(4) << it.mean_similarity
-        << (half ? "h " : "  ") << std::setprecision(3) << it.kappa << "  " << it.mean_step_px << "/" << it.max_step_px
-        << "  " << it.regularizer_report << "  " << std::setprecision(2) << it.seconds << "\n";
+        << (half ? "h " : "  ") << std::setprecision(3) << it.kappa << "  " << it.mean_step_px
+        << "/" << it.max_step_px << "  " << it.regularizer_report << "  " << std::setprecision(2)
+        << it.seconds << "\n";
     out.unsetf(std::ios::fixed);
   }
   if (any_half) out << "  h: the similarity over half of the pairs (pair_halves_min_views)\n";
@@ -650,8 +651,13 @@ RefineSummary RefineMesh(const ViewSource& input_source, const RefineOptions& op
     MR_LOG(INFO) << "Level " << level << ": " << views[0].width << "x" << views[0].height
                  << " images, " << F.rows() << " faces";
     const bool use_silhouettes = options.silhouette_weight > 0 && source.HasMasks();
+    // Whether iteration k of the level uses all pairs (pair_halves_min_views);
+    // only the similarities of all pairs are compared with each other
+    // (min_improvement, best_iterate_giveback).
+    auto uses_all_pairs = [&](int k) {
+      return pair_halves.empty() || k == 0 || k >= options.iterations_per_level - 2;
+    };
     double previous_similarity = 0;
-    bool previous_all_pairs = true;
     Eigen::MatrixXd V_last_iterate;  // the mesh whose similarity is previous_similarity
     // The level's similarities so far (reset when the cameras change) and its
     // best iterate, for best_iterate_giveback.
@@ -707,10 +713,7 @@ RefineSummary RefineMesh(const ViewSource& input_source, const RefineOptions& op
       };
       std::function<void(int, const RenderBuffers&)> visit;
       if (use_silhouettes) visit = add_silhouette;
-      // Only the similarities of all pairs are compared with each other
-      // (min_improvement, best_iterate_giveback).
-      const bool all_pairs =
-          pair_halves.empty() || it == 0 || it >= options.iterations_per_level - 2;
+      const bool all_pairs = uses_all_pairs(it);
       const auto& iteration_pairs = all_pairs ? pairs : pair_halves[(it - 1) % 2];
       record.num_pairs = static_cast<int>(iteration_pairs.size());
       const DataTerm term = ComputeDataTerm(geometry, views, iteration_pairs, level, similarity,
@@ -729,7 +732,7 @@ RefineSummary RefineMesh(const ViewSource& input_source, const RefineOptions& op
       }
       // The level has converged when the last step raised the similarity by
       // less than min_improvement; a step that lowered it is taken back.
-      if (it >= 1 && options.min_improvement > 0 && all_pairs && previous_all_pairs &&
+      if (it >= 1 && options.min_improvement > 0 && all_pairs && uses_all_pairs(it - 1) &&
           record.mean_similarity - previous_similarity < options.min_improvement) {
         const bool worse = record.mean_similarity < previous_similarity;
         if (worse) V = V_last_iterate;
@@ -742,7 +745,6 @@ RefineSummary RefineMesh(const ViewSource& input_source, const RefineOptions& op
         break;
       }
       previous_similarity = record.mean_similarity;
-      previous_all_pairs = all_pairs;
       if (options.min_improvement > 0) V_last_iterate = V;
       if (all_pairs) {
         level_similarities.push_back(record.mean_similarity);
@@ -864,12 +866,15 @@ RefineSummary RefineMesh(const ViewSource& input_source, const RefineOptions& op
     // Poisson in a closed blob: docs/results.md).
     const int best = BestIterateToKeep(level_similarities, options.best_iterate_giveback);
     std::vector<int> resets_after_best;
-    for (const auto& r : summary.iterations) {
-      if (r.level == level && r.iteration >= best_iteration) {
-        resets_after_best.push_back(r.vertices_reset);
+    if (best >= 0) {
+      for (const auto& r : summary.iterations) {
+        if (r.level == level && r.iteration >= best_iteration) {
+          resets_after_best.push_back(r.vertices_reset);
+        }
       }
     }
-    const double reset_fraction = MeanResetFraction(resets_after_best, static_cast<int>(V.rows()));
+    const double reset_fraction =
+        MeanResetFraction(resets_after_best, static_cast<int>(V.rows()));
     if (best >= 0 && !(reset_fraction > kGuardOverrideFraction)) {
       MR_LOG(INFO) << "Level " << level << ": the similarity fell from " << best_similarity
                    << " (after " << best_iteration << " iterations) to "
@@ -877,8 +882,7 @@ RefineSummary RefineMesh(const ViewSource& input_source, const RefineOptions& op
                    << 100 * reset_fraction << " % of the vertices per iteration after it ("
                    << 100 * kGuardOverrideFraction
                    << " % marks a level that the guard drove): the last iterate is kept";
-    }
-    if (best >= 0 && reset_fraction > kGuardOverrideFraction) {
+    } else if (best >= 0) {
       const int dropped = static_cast<int>(resets_after_best.size());
       MR_LOG(INFO) << "Level " << level << " ends on the mesh after " << best_iteration
                    << " iterations: the similarity fell from " << best_similarity << " to "
