@@ -218,12 +218,15 @@ DataTerm ComputeDataTerm(const MeshGeometry& mesh, const std::vector<PinholeView
 }
 
 // Mean plain-ZNCC similarity of all pairs at full resolution through (V, F).
+// `visit` (optional) sees each render of a view in a pair, as in
+// ComputeDataTerm.
 double FullResolutionSimilarity(const std::vector<PinholeView>& views,
                                 const std::vector<std::pair<int, int>>& pairs,
                                 const SimilarityOptions& similarity,
                                 const PairTermOptions& pair_options, const Eigen::MatrixXd& V,
                                 const Eigen::MatrixXi& F, Renderer* renderer, size_t cache_bytes,
-                                ImageCache* images) {
+                                ImageCache* images,
+                                const std::function<void(int, const RenderBuffers&)>& visit = {}) {
   RenderCache renders(renderer, views, cache_bytes);
   renderer->SetMesh(V, F);
   MeshGeometry geometry{&V, &F, FaceNormals(V, F)};
@@ -231,25 +234,36 @@ double FullResolutionSimilarity(const std::vector<PinholeView>& views,
   plain.method = "zncc";
   plain.kappa = 0;
   return ComputeDataTerm(geometry, views, pairs, 0, plain, pair_options, &renders, images,
-                         /*with_gradient=*/false)
+                         /*with_gradient=*/false, visit)
       .MeanSimilarity();
 }
 
 // Per-vertex colours: the mean colour of each vertex over the views where
-// it is visible, weighted by the cosine of the viewing angle.
-void SampleVertexColors(const ViewSource& source, const std::vector<PinholeView>& views,
-                        const Eigen::MatrixXd& V, const Eigen::MatrixXi& F, Renderer* renderer,
-                        Eigen::Matrix<uint8_t, Eigen::Dynamic, 3>* colors) {
-  const Eigen::MatrixXd N = VertexNormals(V, F);
-  Eigen::MatrixXd sum = Eigen::MatrixXd::Zero(V.rows(), 3);
-  Eigen::VectorXd weight = Eigen::VectorXd::Zero(V.rows());
-  renderer->SetMesh(V, F);
-  for (int i = 0; i < source.NumViews(); ++i) {
-    const PinholeView& view = views[i];
-    const RenderBuffers render = renderer->Render(view);
-    const cv::Mat color = source.LoadColor(i);
-    for (int v = 0; v < V.rows(); ++v) {
-      const Eigen::Vector3d x = V.row(v);
+// it is visible, weighted by the cosine of the viewing angle. Each view is
+// added once with its render of (V, F) (the final similarity pass lends its
+// renders, so that the views are not rendered twice); Colors() renders the
+// views that were not added.
+class VertexColorSampler {
+ public:
+  VertexColorSampler(const ViewSource& source, const std::vector<PinholeView>& views,
+                     const Eigen::MatrixXd& V, const Eigen::MatrixXi& F)
+      : source_(source),
+        views_(views),
+        V_(V),
+        F_(F),
+        N_(VertexNormals(V, F)),
+        sum_(Eigen::MatrixXd::Zero(V.rows(), 3)),
+        weight_(Eigen::VectorXd::Zero(V.rows())),
+        added_(views.size(), 0) {}
+
+  void Add(int i, const RenderBuffers& render) {
+    if (added_[i]) return;
+    added_[i] = 1;
+    const PinholeView& view = views_[i];
+    const cv::Mat color = source_.LoadColor(i);
+#pragma omp parallel for schedule(static)
+    for (int v = 0; v < V_.rows(); ++v) {
+      const Eigen::Vector3d x = V_.row(v);
       const Eigen::Vector3d xc = view.WorldToCamera(x);
       if (xc.z() <= 0) continue;
       const Eigen::Vector2d p = view.CameraToImage(xc);
@@ -257,20 +271,42 @@ void SampleVertexColors(const ViewSource& source, const std::vector<PinholeView>
       const int col = static_cast<int>(p.x()), row = static_cast<int>(p.y());
       const float d = render.DepthAt(row, col);
       if (render.FaceAt(row, col) < 0 || std::abs(d - xc.z()) > 0.01 * xc.z()) continue;
-      const double w = N.row(v).dot((view.Center() - x).normalized());
+      const double w = N_.row(v).dot((view.Center() - x).normalized());
       if (w <= 0) continue;
       const cv::Vec3b bgr = color.at<cv::Vec3b>(row, col);
-      sum.row(v) += w * Eigen::Vector3d(bgr[2], bgr[1], bgr[0]).transpose();
-      weight(v) += w;
+      sum_.row(v) += w * Eigen::Vector3d(bgr[2], bgr[1], bgr[0]).transpose();
+      weight_(v) += w;
     }
   }
-  colors->resize(V.rows(), 3);
-  for (int v = 0; v < V.rows(); ++v) {
-    const Eigen::Vector3d c =
-        weight(v) > 0 ? Eigen::Vector3d(sum.row(v) / weight(v)) : Eigen::Vector3d(128, 128, 128);
-    for (int k = 0; k < 3; ++k) (*colors)(v, k) = static_cast<uint8_t>(std::clamp(c(k), 0.0, 255.0));
+
+  void Colors(Renderer* renderer, Eigen::Matrix<uint8_t, Eigen::Dynamic, 3>* colors) {
+    bool mesh_set = false;
+    for (int i = 0; i < static_cast<int>(views_.size()); ++i) {
+      if (added_[i]) continue;
+      if (!mesh_set) renderer->SetMesh(V_, F_);
+      mesh_set = true;
+      Add(i, renderer->Render(views_[i]));
+    }
+    colors->resize(V_.rows(), 3);
+    for (int v = 0; v < V_.rows(); ++v) {
+      const Eigen::Vector3d c = weight_(v) > 0 ? Eigen::Vector3d(sum_.row(v) / weight_(v))
+                                               : Eigen::Vector3d(128, 128, 128);
+      for (int k = 0; k < 3; ++k) {
+        (*colors)(v, k) = static_cast<uint8_t>(std::clamp(c(k), 0.0, 255.0));
+      }
+    }
   }
-}
+
+ private:
+  const ViewSource& source_;
+  const std::vector<PinholeView>& views_;
+  const Eigen::MatrixXd& V_;
+  const Eigen::MatrixXi& F_;
+  const Eigen::MatrixXd N_;
+  Eigen::MatrixXd sum_;
+  Eigen::VectorXd weight_;
+  std::vector<char> added_;
+};
 
 struct Schedule {
   int num_levels = 1;
@@ -914,8 +950,10 @@ RefineSummary RefineMesh(const ViewSource& input_source, const RefineOptions& op
     MR_LOG(INFO) << "Self-intersections: " << repair.BriefReport();
     summary.self_intersections = static_cast<int>(repair.final_pairs);
   }
-  summary.final_similarity = FullResolutionSimilarity(cameras, pairs, similarity, options.pair, V, F,
-                                                      renderer, cache_bytes / 2, &images);
+  VertexColorSampler colors(source, cameras, V, F);
+  summary.final_similarity = FullResolutionSimilarity(
+      cameras, pairs, similarity, options.pair, V, F, renderer, cache_bytes / 2, &images,
+      [&colors](int i, const RenderBuffers& render) { colors.Add(i, render); });
   const SurfaceDisplacement moved = MeasureSurfaceDisplacement(V, V_input, F_input);
   summary.mean_displacement = moved.mean;
   summary.max_displacement = moved.max;
@@ -923,7 +961,7 @@ RefineSummary RefineMesh(const ViewSource& input_source, const RefineOptions& op
   mesh->F = F;
   mesh->N.resize(0, 3);
   mesh->values.resize(0);
-  SampleVertexColors(source, cameras, V, F, renderer, &mesh->C);
+  colors.Colors(renderer, &mesh->C);
   if (options.refine_cameras != "none") {
     // Back to the resolution of the input source (max_image_size scaled it).
     for (int i = 0; i < source.NumViews(); ++i) {
