@@ -283,8 +283,10 @@ class VertexColorSampler {
     bool mesh_set = false;
     for (int i = 0; i < static_cast<int>(views_.size()); ++i) {
       if (added_[i]) continue;
-      if (!mesh_set) renderer->SetMesh(V_, F_);
-      mesh_set = true;
+      if (!mesh_set) {
+        renderer->SetMesh(V_, F_);
+        mesh_set = true;
+      }
       Add(i, renderer->Render(views_[i]));
     }
     colors->resize(V_.rows(), 3);
