@@ -15,7 +15,9 @@
 # "zncc+laplacian"; CONFIGS adds more, one "label|flags" per line, e.g.
 #   CONFIGS='lp|--Refine.regularizer lp' bash benchmark/refine/run_corpus.sh /tmp/corpus
 # BASELINE=0 leaves the baseline out, DEFAULTS=0 the defaults; BIN points
-# at another build's bin/.
+# at another build's bin/. NOMASK=1 refines every case without its masks (a
+# workspace of links, OUT_DIR/<case>.nomask/dense, beside the original; the
+# results get ".nomask" in their names; the evaluation is the same).
 set -euo pipefail
 cd "$(dirname "$0")/../.."
 # shellcheck source=benchmark/refine/corpus_lib.sh
@@ -55,18 +57,28 @@ for name in $cases; do
     [ -z "$config" ] && continue
     label=${config%%|*}
     rflags=${config#*|}
-    out="$ws/dense/meshed-refined-${label//[^A-Za-z0-9_.-]/_}.ply"
-    stem="$OUT/$name.${label//[^A-Za-z0-9_.-]/_}"
+    suffix=""
+    refine_ws="$ws/dense"
+    if [ "${NOMASK:-0}" = 1 ]; then
+      suffix=".nomask"
+      refine_ws="$OUT/$name.nomask/dense"
+      if [ ! -d "$refine_ws" ]; then
+        mkdir -p "$refine_ws"
+        for f in images sparse meshed-poisson.ply; do ln -s "$ws/dense/$f" "$refine_ws/$f"; done
+      fi
+    fi
+    out="$ws/dense/meshed-refined-${label//[^A-Za-z0-9_.-]/_}$suffix.ply"
+    stem="$OUT/$name.${label//[^A-Za-z0-9_.-]/_}$suffix"
     if [ ! -f "$stem.json" ]; then
       echo "[$(date +%T)] $name: $label" >&2
       # shellcheck disable=SC2086
-      /usr/bin/time -f "%e %M" -o "$stem.time" "$BIN/mesh_refiner" --workspace_path "$ws/dense" \
+      /usr/bin/time -f "%e %M" -o "$stem.time" "$BIN/mesh_refiner" --workspace_path "$refine_ws" \
         --output_path "$out" $rflags > "$stem.log" 2>&1 || {
           echo "mesh_refiner failed on $name ($label): see $stem.log" >&2; continue; }
       evaluate "$name" "$out" > "$stem.json"
     fi
     read -r secs kb < "$stem.time"
-    printf '%s\t%s\t%s\t%s\t%s\n' "$name" "$label" "$(cat "$stem.json")" "$secs" "$((kb / 1024))" >> "$TSV"
+    printf '%s\t%s\t%s\t%s\t%s\n' "$name" "$label$suffix" "$(cat "$stem.json")" "$secs" "$((kb / 1024))" >> "$TSV"
   done <<< "$configs"
 done
 python3 benchmark/refine/corpus_table.py "$TSV" | tee "$OUT/results.md"
