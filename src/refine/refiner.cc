@@ -903,37 +903,38 @@ RefineSummary RefineMesh(const ViewSource& input_source, const RefineOptions& op
     // best: the guard, not the images, drove it (an open shell wrapped by
     // Poisson in a closed blob: docs/results.md).
     const int best = BestIterateToKeep(level_similarities, options.best_iterate_giveback);
-    std::vector<int> resets_after_best;
     if (best >= 0) {
+      std::vector<int> resets_after_best;
       for (const auto& r : summary.iterations) {
         if (r.level == level && r.iteration >= best_iteration) {
           resets_after_best.push_back(r.vertices_reset);
         }
       }
-    }
-    const double reset_fraction =
-        MeanResetFraction(resets_after_best, static_cast<int>(V.rows()));
-    if (best >= 0 && !(reset_fraction > kGuardOverrideFraction)) {
-      MR_LOG(INFO) << "Level " << level << ": the similarity fell from " << best_similarity
-                   << " (after " << best_iteration << " iterations) to "
-                   << level_similarities.back() << ", but the self-intersection guard reset only "
-                   << 100 * reset_fraction << " % of the vertices per iteration after it ("
-                   << 100 * kGuardOverrideFraction
-                   << " % marks a level that the guard drove): the last iterate is kept";
-    } else if (best >= 0) {
-      const int dropped = static_cast<int>(resets_after_best.size());
-      MR_LOG(INFO) << "Level " << level << " ends on the mesh after " << best_iteration
-                   << " iterations: the similarity fell from " << best_similarity << " to "
-                   << level_similarities.back() << ", more than "
-                   << options.best_iterate_giveback << " of the gain "
-                   << best_similarity - level_similarities.front()
-                   << " up to it, while the self-intersection guard reset "
-                   << 100 * reset_fraction << " % of the vertices per iteration (" << dropped
-                   << " iterations dropped)";
-      V = V_best;
-      guard_verified_clean = false;
-      ++summary.levels_ended_on_best;
-      summary.iterations_dropped += dropped;
+      const double reset_fraction =
+          MeanResetFraction(resets_after_best, static_cast<int>(V.rows()));
+      if (!(reset_fraction > kGuardOverrideFraction)) {
+        MR_LOG(INFO) << "Level " << level << ": the similarity fell from " << best_similarity
+                     << " (after " << best_iteration << " iterations) to "
+                     << level_similarities.back()
+                     << ", but the self-intersection guard reset only " << 100 * reset_fraction
+                     << " % of the vertices per iteration after it ("
+                     << 100 * kGuardOverrideFraction
+                     << " % marks a level that the guard drove): the last iterate is kept";
+      } else {
+        const int dropped = static_cast<int>(resets_after_best.size());
+        MR_LOG(INFO) << "Level " << level << " ends on the mesh after " << best_iteration
+                     << " iterations: the similarity fell from " << best_similarity << " to "
+                     << level_similarities.back() << ", more than "
+                     << options.best_iterate_giveback << " of the gain "
+                     << best_similarity - level_similarities.front()
+                     << " up to it, while the self-intersection guard reset "
+                     << 100 * reset_fraction << " % of the vertices per iteration (" << dropped
+                     << " iterations dropped)";
+        V = V_best;
+        guard_verified_clean = false;
+        ++summary.levels_ended_on_best;
+        summary.iterations_dropped += dropped;
+      }
     }
   }
 
