@@ -490,6 +490,7 @@ bool RefineOptions::Check() const {
   }
   if (!(silhouette_weight >= 0)) fail("silhouette_weight", std::to_string(silhouette_weight), "silhouette_weight >= 0");
   if (cache_mb < 64) fail("cache_mb", std::to_string(cache_mb), "cache_mb >= 64");
+  background_mask.Check();
   view_selection.Check();
   similarity_options.Check();
   pair.Check();
@@ -548,21 +549,31 @@ std::string RefineSummary::FullReport() const {
 RefineSummary RefineMesh(const ViewSource& input_source, const RefineOptions& options,
                          TriangleMesh* mesh, Renderer* renderer) {
   options.Check();
-  // Everything below works at the working resolution.
-  const ResizedViewSource source(input_source, options.max_image_size);
   const double t_start = ElapsedSeconds();
   if (mesh->NumFaces() == 0 || mesh->NumVertices() == 0) {
     MR_THROW_INPUT << "the input mesh is empty (" << mesh->NumVertices() << " vertices, "
                    << mesh->NumFaces() << " faces)";
   }
-  if (source.NumViews() < 2) {
-    MR_THROW_INPUT << "refinement needs at least 2 views, got " << source.NumViews();
+  if (input_source.NumViews() < 2) {
+    MR_THROW_INPUT << "refinement needs at least 2 views, got " << input_source.NumViews();
   }
   std::unique_ptr<Renderer> own_renderer;
   if (renderer == nullptr) {
     own_renderer = std::make_unique<Renderer>();
     renderer = own_renderer.get();
   }
+  // Without masks, masks from a uniform background where they agree with the
+  // input mesh, for the silhouette term.
+  std::unique_ptr<BackgroundMaskedViewSource> background_masked;
+  if (!input_source.HasMasks() && options.masks_from_background && options.silhouette_weight > 0) {
+    BackgroundMaskReport report;
+    background_masked = MakeBackgroundMasks(input_source, mesh->V, mesh->F, renderer,
+                                            options.background_mask, &report);
+    MR_LOG(INFO) << "No masks given: " << report.BriefReport();
+  }
+  // Everything below works at the working resolution.
+  const ResizedViewSource source(background_masked ? *background_masked : input_source,
+                                 options.max_image_size);
 
   RefineSummary summary;
   summary.num_views = source.NumViews();
@@ -1036,6 +1047,17 @@ void RegisterRefineOptions(OptionManager* o, RefineOptions* r) {
          "lp proximal step: noise estimated from what the gradient step added, not the surface");
   o->Add("Refine.silhouette_weight", &r->silhouette_weight,
          "weight of the silhouette term when masks exist (>= 0)");
+  o->Add("Refine.masks_from_background", &r->masks_from_background,
+         "without masks, make them from a uniform background where they agree with the input "
+         "mesh (for the silhouette term)");
+  o->Add("BackgroundMask.min_agreement", &r->background_mask.min_agreement,
+         "a view's background mask is used when its intersection over union with the input "
+         "mesh's rendered coverage is at least this");
+  o->Add("BackgroundMask.max_offset", &r->background_mask.max_offset,
+         "a background mask moves the input mesh's outline by at most this share of the "
+         "image's longest side");
+  o->Add("BackgroundMask.min_border_share", &r->background_mask.min_border_share,
+         "share of the image border that must have the background colour");
   o->Add("Refine.prevent_self_intersections", &r->prevent_self_intersections,
          "undo, every iteration, the moves that make faces intersect");
   o->Add("Refine.cache_mb", &r->cache_mb, "memory budget for cached images and renders (MB)");

@@ -1,0 +1,390 @@
+#include "refine/background_mask.h"
+
+#include <algorithm>
+#include <cmath>
+#include <sstream>
+
+#include <opencv2/imgcodecs.hpp>
+#include <opencv2/imgproc.hpp>
+
+#include "render/renderer.h"
+#include "util/error.h"
+#include "util/logging.h"
+
+namespace mr {
+
+bool BackgroundMaskOptions::Check() const {
+  auto fail = [](const std::string& name, double value, const std::string& constraint) {
+    MR_THROW_INPUT << "BackgroundMaskOptions::" << name << " = " << value
+                   << ". Violated constraint: " << constraint;
+  };
+  if (border_px < 1) fail("border_px", border_px, "border_px >= 1");
+  if (!(min_border_share > 0 && min_border_share <= 1)) {
+    fail("min_border_share", min_border_share, "0 < min_border_share <= 1");
+  }
+  if (!(min_tolerance >= 0)) fail("min_tolerance", min_tolerance, "min_tolerance >= 0");
+  if (!(tolerance_sigmas >= 0)) fail("tolerance_sigmas", tolerance_sigmas, "tolerance_sigmas >= 0");
+  if (!(max_spread >= 0)) fail("max_spread", max_spread, "max_spread >= 0");
+  if (!(min_hole_share >= 0 && min_hole_share <= 1)) {
+    fail("min_hole_share", min_hole_share, "0 <= min_hole_share <= 1");
+  }
+  if (!(min_agreement >= 0 && min_agreement <= 1)) {
+    fail("min_agreement", min_agreement, "0 <= min_agreement <= 1");
+  }
+  if (min_object_px < 0) fail("min_object_px", min_object_px, "min_object_px >= 0");
+  if (!(max_offset >= 0 && max_offset <= 1)) fail("max_offset", max_offset, "0 <= max_offset <= 1");
+  if (!(min_support >= 0 && min_support <= 1)) fail("min_support", min_support, "0 <= min_support <= 1");
+  if (!(visibility_tolerance > 0)) {
+    fail("visibility_tolerance", visibility_tolerance, "visibility_tolerance > 0");
+  }
+  return true;
+}
+
+namespace {
+
+// The image as BGR, 3x3 median filtered.
+cv::Mat Smoothed(const cv::Mat& image) {
+  MR_CHECK(image.depth() == CV_8U && (image.channels() == 1 || image.channels() == 3))
+      << "8-bit grey or BGR image expected";
+  cv::Mat bgr;
+  if (image.channels() == 1) {
+    cv::cvtColor(image, bgr, cv::COLOR_GRAY2BGR);
+  } else {
+    bgr = image;
+  }
+  cv::Mat filtered;
+  cv::medianBlur(bgr, filtered, 3);
+  return filtered;
+}
+
+// Largest channel difference between a pixel and a colour.
+inline double ColorDistance(const cv::Vec3b& p, const cv::Vec3d& c) {
+  return std::max({std::abs(p[0] - c[0]), std::abs(p[1] - c[1]), std::abs(p[2] - c[2])});
+}
+
+double Median(std::vector<double>* values) {
+  MR_CHECK(!values->empty());
+  const size_t mid = values->size() / 2;
+  std::nth_element(values->begin(), values->begin() + mid, values->end());
+  return (*values)[mid];
+}
+
+// The pixels of the border band of width `band`.
+template <typename Visit>
+void ForEachBorderPixel(const cv::Mat& image, int band, Visit visit) {
+  band = std::min({band, image.rows / 2, image.cols / 2});
+  for (int r = 0; r < image.rows; ++r) {
+    const cv::Vec3b* row = image.ptr<cv::Vec3b>(r);
+    const bool full = r < band || r >= image.rows - band;
+    for (int c = 0; c < image.cols; ++c) {
+      if (full || c < band || c >= image.cols - band) visit(row[c]);
+      if (!full && c == band - 1) c = image.cols - band - 1;  // skip the interior
+    }
+  }
+}
+
+BackgroundModel EstimateFiltered(const cv::Mat& filtered, const BackgroundMaskOptions& options) {
+  std::vector<double> channel[3];
+  ForEachBorderPixel(filtered, options.border_px, [&](const cv::Vec3b& p) {
+    for (int k = 0; k < 3; ++k) channel[k].push_back(p[k]);
+  });
+  BackgroundModel model;
+  for (int k = 0; k < 3; ++k) {
+    std::vector<double> values = channel[k];
+    model.color[k] = Median(&values);
+    for (double& v : values) v = std::abs(v - model.color[k]);
+    model.spread = std::max(model.spread, 1.4826 * Median(&values));
+  }
+  model.tolerance = std::max(options.min_tolerance, options.tolerance_sigmas * model.spread);
+  long within = 0, total = 0;
+  ForEachBorderPixel(filtered, options.border_px, [&](const cv::Vec3b& p) {
+    within += ColorDistance(p, model.color) <= model.tolerance ? 1 : 0;
+    ++total;
+  });
+  model.border_share = static_cast<double>(within) / std::max(1L, total);
+  model.uniform = model.border_share >= options.min_border_share && model.spread <= options.max_spread;
+  return model;
+}
+
+cv::Mat MaskOfFiltered(const cv::Mat& filtered, const BackgroundModel& model,
+                       const BackgroundMaskOptions& options) {
+  const int rows = filtered.rows, cols = filtered.cols;
+  cv::Mat distance(filtered.size(), CV_32F), like(filtered.size(), CV_8U);
+  for (int r = 0; r < rows; ++r) {
+    const cv::Vec3b* src = filtered.ptr<cv::Vec3b>(r);
+    float* d = distance.ptr<float>(r);
+    uchar* l = like.ptr<uchar>(r);
+    for (int c = 0; c < cols; ++c) {
+      d[c] = static_cast<float>(ColorDistance(src[c], model.color));
+      l[c] = d[c] <= model.tolerance ? 1 : 0;
+    }
+  }
+  // Background is 4-connected, the object 8-connected. A background-coloured
+  // region is background where it touches the border or is a large hole;
+  // an object region smaller than min_object_px is noise.
+  cv::Mat labels, stats, centroids;
+  auto label = [&](const cv::Mat& binary, int connectivity, auto keep) {
+    const int n = cv::connectedComponentsWithStats(binary, labels, stats, centroids, connectivity);
+    std::vector<uchar> kept(n, 0);
+    for (int k = 1; k < n; ++k) {
+      const int x = stats.at<int>(k, cv::CC_STAT_LEFT), y = stats.at<int>(k, cv::CC_STAT_TOP);
+      const int w = stats.at<int>(k, cv::CC_STAT_WIDTH), h = stats.at<int>(k, cv::CC_STAT_HEIGHT);
+      const bool touches = x == 0 || y == 0 || x + w == cols || y + h == rows;
+      kept[k] = keep(touches, stats.at<int>(k, cv::CC_STAT_AREA)) ? 1 : 0;
+    }
+    return kept;
+  };
+  const double min_hole = options.min_hole_share * rows * cols;
+  const std::vector<uchar> background =
+      label(like, 4, [&](bool touches, int area) { return touches || area >= min_hole; });
+  cv::Mat mask(filtered.size(), CV_8U);
+  for (int r = 0; r < rows; ++r) {
+    const int* l = labels.ptr<int>(r);
+    const uchar* is_like = like.ptr<uchar>(r);
+    uchar* m = mask.ptr<uchar>(r);
+    for (int c = 0; c < cols; ++c) m[c] = is_like[c] && background[l[c]] ? 0 : 255;
+  }
+  const std::vector<uchar> object =
+      label(mask, 8, [&](bool, int area) { return area >= options.min_object_px; });
+  for (int r = 0; r < rows; ++r) {
+    const int* l = labels.ptr<int>(r);
+    uchar* m = mask.ptr<uchar>(r);
+    for (int c = 0; c < cols; ++c) m[c] = m[c] && object[l[c]] ? 255 : 0;
+  }
+  // The outline at half coverage: a pixel of the object next to the
+  // background that differs from it by less than half as much as the object
+  // pixels beside it is mostly background (an anti-aliased edge pixel).
+  const cv::Mat before = mask.clone();
+  auto at = [&](const cv::Mat& m, int r, int c) {
+    return r >= 0 && r < rows && c >= 0 && c < cols ? m.at<uchar>(r, c) : uchar{255};
+  };
+  auto on_outline = [&](int r, int c) {
+    return at(before, r - 1, c) == 0 || at(before, r + 1, c) == 0 || at(before, r, c - 1) == 0 ||
+           at(before, r, c + 1) == 0;
+  };
+  for (int r = 0; r < rows; ++r) {
+    for (int c = 0; c < cols; ++c) {
+      if (!before.at<uchar>(r, c) || !on_outline(r, c)) continue;
+      float inside = 0;  // the mean of the object pixels within 2 px that are not on the outline
+      int count = 0;
+      for (int dr = -2; dr <= 2; ++dr) {
+        for (int dc = -2; dc <= 2; ++dc) {
+          const int rr = r + dr, cc = c + dc;
+          if (rr < 0 || rr >= rows || cc < 0 || cc >= cols || !before.at<uchar>(rr, cc) ||
+              on_outline(rr, cc)) {
+            continue;
+          }
+          inside += distance.at<float>(rr, cc);
+          ++count;
+        }
+      }
+      if (count > 0) inside /= count;
+      if (inside > 0 && distance.at<float>(r, c) < 0.5f * inside) mask.at<uchar>(r, c) = 0;
+    }
+  }
+  return mask;
+}
+
+}  // namespace
+
+BackgroundModel EstimateBackground(const cv::Mat& image, const BackgroundMaskOptions& options) {
+  options.Check();
+  return EstimateFiltered(Smoothed(image), options);
+}
+
+cv::Mat BackgroundMask(const cv::Mat& image, const BackgroundModel& model,
+                       const BackgroundMaskOptions& options) {
+  return MaskOfFiltered(Smoothed(image), model, options);
+}
+
+double MaskAgreement(const cv::Mat& a, const cv::Mat& b) {
+  MR_CHECK(a.size() == b.size() && a.type() == CV_8U && b.type() == CV_8U);
+  const int both = cv::countNonZero(a & b), either = cv::countNonZero(a | b);
+  return either == 0 ? 1.0 : static_cast<double>(both) / either;
+}
+
+BackgroundMaskedViewSource::BackgroundMaskedViewSource(const ViewSource& base,
+                                                       std::vector<std::vector<uchar>> masks)
+    : base_(base), masks_(std::move(masks)) {
+  MR_CHECK(static_cast<int>(masks_.size()) == base_.NumViews());
+  for (const auto& m : masks_) num_masked_ += m.empty() ? 0 : 1;
+}
+
+cv::Mat BackgroundMaskedViewSource::LoadMask(int i) const {
+  const std::vector<uchar>& png = masks_.at(i);
+  if (png.empty()) return {};
+  return cv::imdecode(png, cv::IMREAD_GRAYSCALE);
+}
+
+cv::Mat LimitToOutlineBand(const cv::Mat& mask, const cv::Mat& covered, double max_offset_px) {
+  MR_CHECK(mask.size() == covered.size() && mask.type() == CV_8U && covered.type() == CV_8U);
+  // Distance of each pixel to the nearest pixel on the other side of the
+  // outline of `covered`.
+  cv::Mat inside, outside;
+  const cv::Mat in = covered > 0;
+  cv::distanceTransform(in, inside, cv::DIST_L2, cv::DIST_MASK_PRECISE);
+  cv::distanceTransform(~in, outside, cv::DIST_L2, cv::DIST_MASK_PRECISE);
+  cv::Mat out = in.clone();
+  for (int r = 0; r < out.rows; ++r) {
+    const uchar* m = mask.ptr<uchar>(r);
+    const float* di = inside.ptr<float>(r);
+    const float* dout = outside.ptr<float>(r);
+    uchar* o = out.ptr<uchar>(r);
+    for (int c = 0; c < out.cols; ++c) {
+      const bool object = m[c] > 0;
+      if (object != (o[c] > 0) && (o[c] ? di[c] : dout[c]) <= max_offset_px) {
+        o[c] = object ? 255 : 0;
+      }
+    }
+  }
+  return out;
+}
+
+std::string BackgroundMaskReport::BriefReport() const {
+  std::vector<double> accepted;
+  for (double a : agreement) {
+    if (a >= 0) accepted.push_back(a);
+  }
+  std::ostringstream out;
+  out.precision(3);
+  out << num_uniform << " of " << num_views << " views have a uniform background; "
+      << num_accepted << " agree with the input mesh and get masks";
+  if (num_removals > 0) {
+    out << "; " << num_confirmed << " of " << num_removals
+        << " pixels they take from the mesh are confirmed by other views";
+  }
+  if (!accepted.empty()) {
+    std::sort(accepted.begin(), accepted.end());
+    out << " (mask vs rendered mesh, intersection over union: min " << accepted.front()
+        << ", median " << accepted[accepted.size() / 2] << ")";
+  }
+  return out.str();
+}
+
+cv::Mat RenderedCoverage(const RenderBuffers& render) {
+  cv::Mat covered(render.height, render.width, CV_8U);
+  for (int r = 0; r < render.height; ++r) {
+    uchar* row = covered.ptr<uchar>(r);
+    for (int c = 0; c < render.width; ++c) row[c] = render.FaceAt(r, c) >= 0 ? 255 : 0;
+  }
+  return covered;
+}
+
+namespace {
+
+// A pixel the mask takes from the input mesh's coverage, with the mesh's
+// point it shows and how the other views see that point.
+struct Removal {
+  int row = 0, col = 0;
+  Eigen::Vector3d X;
+  int views = 0;          // other views in which X is visible (a uniform background)
+  int object_views = 0;   // ... and whose pixel there differs from their background
+};
+
+}  // namespace
+
+std::unique_ptr<BackgroundMaskedViewSource> MakeBackgroundMasks(
+    const ViewSource& source, const Eigen::MatrixXd& V, const Eigen::MatrixXi& F,
+    Renderer* renderer, const BackgroundMaskOptions& options, BackgroundMaskReport* report) {
+  options.Check();
+  const int n = source.NumViews();
+  BackgroundMaskReport local;
+  local.num_views = n;
+  local.agreement.assign(n, -1.0);
+  std::vector<BackgroundModel> models(n);
+  std::vector<std::vector<uchar>> encoded(n);
+  std::vector<std::vector<Removal>> removals(n);
+  renderer->SetMesh(V, F);
+  // Each view's mask, limited to the band around the mesh's outline; the
+  // pixels it takes from the mesh's coverage are kept as removals.
+  for (int i = 0; i < n; ++i) {
+    const cv::Mat filtered = Smoothed(source.LoadColor(i));
+    models[i] = EstimateFiltered(filtered, options);
+    const BackgroundModel& model = models[i];
+    if (!model.uniform) {
+      MR_LOG(VERBOSE) << source.Name(i) << ": no uniform background (spread " << model.spread
+                      << ", " << 100 * model.border_share << " % of the border within "
+                      << model.tolerance << ")";
+      continue;
+    }
+    ++local.num_uniform;
+    const PinholeView& view = source.View(i);
+    const cv::Mat mask = MaskOfFiltered(filtered, model, options);
+    const RenderBuffers render = renderer->Render(view);
+    const cv::Mat covered = RenderedCoverage(render);
+    local.agreement[i] = MaskAgreement(mask, covered);
+    const bool accepted = local.agreement[i] >= options.min_agreement;
+    MR_LOG(VERBOSE) << source.Name(i) << ": background (B, G, R) = (" << model.color[0] << ", "
+                    << model.color[1] << ", " << model.color[2] << "), spread " << model.spread
+                    << ", " << 100 * model.border_share << " % of the border within "
+                    << model.tolerance << "; mask vs rendered mesh " << local.agreement[i]
+                    << (accepted ? "" : ": no mask");
+    if (!accepted) continue;
+    ++local.num_accepted;
+    const double max_offset_px = options.max_offset * std::max(view.width, view.height);
+    const cv::Mat banded = LimitToOutlineBand(mask, covered, max_offset_px);
+    for (int r = 0; r < view.height; ++r) {
+      for (int c = 0; c < view.width; ++c) {
+        if (covered.at<uchar>(r, c) && !banded.at<uchar>(r, c)) {
+          Removal removal;
+          removal.row = r;
+          removal.col = c;
+          removal.X = view.Center() + render.DepthAt(r, c) * view.RayDirection(c + 0.5, r + 0.5);
+          removals[i].push_back(removal);
+          ++local.num_removals;
+        }
+      }
+    }
+    cv::imencode(".png", banded, encoded[i]);
+  }
+  // A removal is confirmed by the other views: a surface point outside the
+  // object lies in front of the object or the background, so the views
+  // that see it face on see the object's colours through it; a dark part of
+  // the object taken for background stays dark in every view (a light fixed
+  // in the world leaves the same side unlit).
+  if (options.min_support > 0 && local.num_accepted > 0) {
+    for (int j = 0; j < n; ++j) {
+      if (!models[j].uniform) continue;
+      const cv::Mat filtered = Smoothed(source.LoadColor(j));
+      const PinholeView& view = source.View(j);
+      const RenderBuffers render = renderer->Render(view);
+      for (int i = 0; i < n; ++i) {
+        if (i == j) continue;
+        for (Removal& removal : removals[i]) {
+          const Eigen::Vector3d Xc = view.WorldToCamera(removal.X);
+          if (!(Xc.z() > 0)) continue;
+          const Eigen::Vector2d q = view.CameraToImage(Xc);
+          if (!view.InImage(q)) continue;
+          const int r = static_cast<int>(q.y()), c = static_cast<int>(q.x());
+          const double depth = render.DepthAt(r, c);
+          if (!(depth > 0) || std::abs(depth - Xc.z()) > options.visibility_tolerance * Xc.z()) {
+            continue;
+          }
+          ++removal.views;
+          if (ColorDistance(filtered.at<cv::Vec3b>(r, c), models[j].color) >
+              options.witness_tolerances * models[j].tolerance) {
+            ++removal.object_views;
+          }
+        }
+      }
+    }
+    for (int i = 0; i < n; ++i) {
+      if (removals[i].empty()) continue;
+      cv::Mat mask = cv::imdecode(encoded[i], cv::IMREAD_GRAYSCALE);
+      for (const Removal& removal : removals[i]) {
+        if (removal.views > 0 && removal.object_views >= options.min_support * removal.views) {
+          ++local.num_confirmed;
+        } else {
+          mask.at<uchar>(removal.row, removal.col) = 255;
+        }
+      }
+      cv::imencode(".png", mask, encoded[i]);
+    }
+  } else {
+    local.num_confirmed = local.num_removals;
+  }
+  if (report) *report = local;
+  return std::make_unique<BackgroundMaskedViewSource>(source, std::move(encoded));
+}
+
+}  // namespace mr
