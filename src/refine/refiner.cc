@@ -562,18 +562,19 @@ RefineSummary RefineMesh(const ViewSource& input_source, const RefineOptions& op
     own_renderer = std::make_unique<Renderer>();
     renderer = own_renderer.get();
   }
+  // Everything below works at the working resolution.
+  const ResizedViewSource working(input_source, options.max_image_size);
   // Without masks, masks from a uniform background where they agree with the
-  // input mesh, for the silhouette term.
+  // input mesh, for the silhouette term (made at the working resolution).
   std::unique_ptr<BackgroundMaskedViewSource> background_masked;
-  if (!input_source.HasMasks() && options.masks_from_background && options.silhouette_weight > 0) {
+  if (!working.HasMasks() && options.masks_from_background && options.silhouette_weight > 0) {
     BackgroundMaskReport report;
-    background_masked = MakeBackgroundMasks(input_source, mesh->V, mesh->F, renderer,
+    background_masked = MakeBackgroundMasks(working, mesh->V, mesh->F, renderer,
                                             options.background_mask, &report);
     MR_LOG(INFO) << "No masks given: " << report.BriefReport();
   }
-  // Everything below works at the working resolution.
-  const ResizedViewSource source(background_masked ? *background_masked : input_source,
-                                 options.max_image_size);
+  const ViewSource& source =
+      background_masked ? static_cast<const ViewSource&>(*background_masked) : working;
 
   RefineSummary summary;
   summary.num_views = source.NumViews();
