@@ -34,6 +34,9 @@ bool BackgroundMaskOptions::Check() const {
   if (min_object_px < 0) fail("min_object_px", min_object_px, "min_object_px >= 0");
   if (!(max_offset >= 0 && max_offset <= 1)) fail("max_offset", max_offset, "0 <= max_offset <= 1");
   if (!(min_support >= 0 && min_support <= 1)) fail("min_support", min_support, "0 <= min_support <= 1");
+  if (!(witness_tolerances >= 1)) {
+    fail("witness_tolerances", witness_tolerances, "witness_tolerances >= 1");
+  }
   if (!(visibility_tolerance > 0)) {
     fail("visibility_tolerance", visibility_tolerance, "visibility_tolerance > 0");
   }
@@ -90,7 +93,7 @@ BackgroundModel EstimateFiltered(const cv::Mat& filtered, const BackgroundMaskOp
   });
   BackgroundModel model;
   for (int k = 0; k < 3; ++k) {
-    std::vector<double> values = channel[k];
+    std::vector<double>& values = channel[k];
     model.color[k] = Median(&values);
     for (double& v : values) v = std::abs(v - model.color[k]);
     model.spread = std::max(model.spread, 1.4826 * Median(&values));
@@ -342,7 +345,7 @@ std::unique_ptr<BackgroundMaskedViewSource> MakeBackgroundMasks(
   // that see it face on see the object's colours through it; a dark part of
   // the object taken for background stays dark in every view (a light fixed
   // in the world leaves the same side unlit).
-  if (options.min_support > 0 && local.num_accepted > 0) {
+  if (options.min_support > 0 && local.num_removals > 0) {
     for (int j = 0; j < n; ++j) {
       if (!models[j].uniform) continue;
       const cv::Mat filtered = Smoothed(source.LoadColor(j));

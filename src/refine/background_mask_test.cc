@@ -119,6 +119,9 @@ TEST(BackgroundMaskTest, OptionsAreChecked) {
   options = {};
   options.max_offset = -0.1;
   EXPECT_THROW(options.Check(), InputError);
+  options = {};
+  options.witness_tolerances = 0.5;
+  EXPECT_THROW(options.Check(), InputError);
 }
 
 // On the refiner's test scene (a textured sphere on black), every view gets a
