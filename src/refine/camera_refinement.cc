@@ -45,11 +45,13 @@ constexpr double kMinGradient = 1e-3;
 // The residual and its Jacobian with respect to every parameter (any pointer
 // may be null). Returns false where the warp is undefined (ray parallel to
 // the plane, plane behind camera i, point behind camera j).
+// `delta` (may be null: 0) shifts the face plane: n·X = plane_offset + δ.
 bool EvaluatePhotometric(const PhotometricSample& s, const cv::Mat& image_j, const double* Ri_p,
                          const double* Ci_p, const double* Ki, const double* Rj_p,
-                         const double* Cj_p, const double* Kj, const double* ab, double* residual,
-                         double* J_Ri, double* J_Ci, double* J_Ki, double* J_Rj, double* J_Cj,
-                         double* J_Kj, double* J_ab) {
+                         const double* Cj_p, const double* Kj, const double* ab,
+                         const double* delta, double* residual, double* J_Ri, double* J_Ci,
+                         double* J_Ki, double* J_Rj, double* J_Cj, double* J_Kj, double* J_ab,
+                         double* J_delta) {
   const Eigen::Map<const RowMatrix3d> Ri(Ri_p), Rj(Rj_p);
   const Eigen::Map<const Eigen::Vector3d> Ci(Ci_p), Cj(Cj_p);
   // Back-projection: m = K_i⁻¹ (p, 1), ray w = R_iᵀ m, hit X = C_i + d w.
@@ -57,7 +59,8 @@ bool EvaluatePhotometric(const PhotometricSample& s, const cv::Mat& image_j, con
   const Eigen::Vector3d w = Ri.transpose() * m;
   const double nw = s.normal.dot(w);
   if (!(std::abs(nw) > 1e-12)) return false;
-  const double d = (s.plane_offset - s.normal.dot(Ci)) / nw;
+  const double offset = s.plane_offset + (delta != nullptr ? delta[0] : 0.0);
+  const double d = (offset - s.normal.dot(Ci)) / nw;
   if (!(d > 0)) return false;
   const Eigen::Vector3d X = Ci + d * w;
   // Projection into view j.
@@ -80,7 +83,8 @@ bool EvaluatePhotometric(const PhotometricSample& s, const cv::Mat& image_j, con
     J_Kj[2] = g.x();
     J_Kj[3] = g.y();
   }
-  if (J_Ri == nullptr && J_Ci == nullptr && J_Ki == nullptr && J_Rj == nullptr && J_Cj == nullptr) {
+  if (J_Ri == nullptr && J_Ci == nullptr && J_Ki == nullptr && J_Rj == nullptr &&
+      J_Cj == nullptr && J_delta == nullptr) {
     return true;
   }
   // G = ∂r/∂X_c = ∇I_jᵀ ∂q/∂X_c.
@@ -96,6 +100,8 @@ bool EvaluatePhotometric(const PhotometricSample& s, const cv::Mat& image_j, con
   if (J_Cj != nullptr) {
     for (int k = 0; k < 3; ++k) J_Cj[k] = -H(k);
   }
+  // The plane's shift moves X along the ray: ∂X/∂δ = w / (n·w).
+  if (J_delta != nullptr) J_delta[0] = H.dot(w) / nw;
   // X moves along the ray onto the plane: ∂X/∂C_i = I - w nᵀ / (n·w),
   // ∂X/∂w = d (I - w nᵀ / (n·w)).
   const Eigen::RowVector3d HP = H - (H.dot(w) / nw) * s.normal.transpose();
@@ -119,34 +125,33 @@ bool EvaluatePhotometric(const PhotometricSample& s, const cv::Mat& image_j, con
   return true;
 }
 
-// Parameters: R_i, C_i, K_i, R_j, C_j, K_j, (a, b).
-class PhotometricCost : public ceres::SizedCostFunction<1, 9, 3, 4, 9, 3, 4, 2> {
+// Parameters: R_i, C_i, K_i, R_j, C_j, K_j, (a, b) and, with a free surface,
+// δ; views i and j of one camera (shared intrinsics): R_i, C_i, R_j, C_j, K,
+// (a, b)[, δ].
+class PhotometricCost : public ceres::CostFunction {
  public:
-  PhotometricCost(const PhotometricSample& sample, const cv::Mat& image_j)
-      : sample_(sample), image_j_(image_j) {}
-  bool Evaluate(double const* const* p, double* residual, double** J) const override {
-    const auto jac = [J](int k) { return J == nullptr ? nullptr : J[k]; };
-    return EvaluatePhotometric(sample_, image_j_, p[0], p[1], p[2], p[3], p[4], p[5], p[6],
-                               residual, jac(0), jac(1), jac(2), jac(3), jac(4), jac(5), jac(6));
+  PhotometricCost(const PhotometricSample& sample, const cv::Mat& image_j, bool shared_intrinsics,
+                  bool free_surface)
+      : sample_(sample), image_j_(image_j), shared_(shared_intrinsics), free_(free_surface) {
+    set_num_residuals(1);
+    std::vector<int32_t>* sizes = mutable_parameter_block_sizes();
+    *sizes = shared_ ? std::vector<int32_t>{9, 3, 9, 3, 4, 2}
+                     : std::vector<int32_t>{9, 3, 4, 9, 3, 4, 2};
+    if (free_) sizes->push_back(1);
   }
-
- private:
-  PhotometricSample sample_;
-  cv::Mat image_j_;
-};
-
-// Views i and j of one camera: R_i, C_i, R_j, C_j, K, (a, b).
-class SharedIntrinsicsPhotometricCost : public ceres::SizedCostFunction<1, 9, 3, 9, 3, 4, 2> {
- public:
-  SharedIntrinsicsPhotometricCost(const PhotometricSample& sample, const cv::Mat& image_j)
-      : sample_(sample), image_j_(image_j) {}
   bool Evaluate(double const* const* p, double* residual, double** J) const override {
     const auto jac = [J](int k) { return J == nullptr ? nullptr : J[k]; };
+    if (!shared_) {
+      return EvaluatePhotometric(sample_, image_j_, p[0], p[1], p[2], p[3], p[4], p[5], p[6],
+                                 free_ ? p[7] : nullptr, residual, jac(0), jac(1), jac(2), jac(3),
+                                 jac(4), jac(5), jac(6), free_ ? jac(7) : nullptr);
+    }
     double J_Ki[4], J_Kj[4];
     const bool want_k = jac(4) != nullptr;
-    if (!EvaluatePhotometric(sample_, image_j_, p[0], p[1], p[4], p[2], p[3], p[4], p[5], residual,
-                             jac(0), jac(1), want_k ? J_Ki : nullptr, jac(2), jac(3),
-                             want_k ? J_Kj : nullptr, jac(5))) {
+    if (!EvaluatePhotometric(sample_, image_j_, p[0], p[1], p[4], p[2], p[3], p[4], p[5],
+                             free_ ? p[6] : nullptr, residual, jac(0), jac(1),
+                             want_k ? J_Ki : nullptr, jac(2), jac(3), want_k ? J_Kj : nullptr,
+                             jac(5), free_ ? jac(6) : nullptr)) {
       return false;
     }
     if (want_k) {
@@ -158,6 +163,8 @@ class SharedIntrinsicsPhotometricCost : public ceres::SizedCostFunction<1, 9, 3,
  private:
   PhotometricSample sample_;
   cv::Mat image_j_;
+  bool shared_;
+  bool free_;
 };
 
 Eigen::Matrix3d Hat(const Eigen::Vector3d& v) {
@@ -255,6 +262,17 @@ struct CenterPrior {
   double inv_sigma;
 };
 
+// Prior on a face plane's offset: δ / sigma.
+struct OffsetPrior {
+  explicit OffsetPrior(double sigma) : inv_sigma(1.0 / sigma) {}
+  template <typename T>
+  bool operator()(const T* delta, T* residual) const {
+    residual[0] = delta[0] * inv_sigma;
+    return true;
+  }
+  double inv_sigma;
+};
+
 // Prior on fx and fy of an intrinsics block (fx, fy, cx, cy).
 struct FocalPrior {
   FocalPrior(double fx0, double fy0, double sigma_fraction)
@@ -274,10 +292,9 @@ struct FocalPrior {
 }  // namespace
 
 ceres::CostFunction* NewPhotometricCost(const PhotometricSample& sample, const cv::Mat& image_j,
-                                        bool shared_intrinsics) {
+                                        bool shared_intrinsics, bool free_surface) {
   MR_CHECK_EQ(image_j.type(), CV_32F);
-  if (shared_intrinsics) return new SharedIntrinsicsPhotometricCost(sample, image_j);
-  return new PhotometricCost(sample, image_j);
+  return new PhotometricCost(sample, image_j, shared_intrinsics, free_surface);
 }
 
 ceres::Manifold* NewRotationMatrixManifold() { return new RotationMatrixManifold(); }
@@ -352,6 +369,8 @@ std::vector<PhotometricSample> SelectSamples(const Eigen::MatrixXd& V, const Eig
       s.plane_offset = offset;
       s.intensity = image_i.at<float>(r, c);
       s.score = score;
+      s.face = f;
+      s.footprint = view_i.WorldToCamera(X).z() / view_i.fx;
       candidates.push_back(s);
     }
   }
@@ -403,6 +422,10 @@ bool CameraRefinementOptions::Check() const {
   positive("prior_rotation_deg", prior_rotation_deg);
   positive("prior_center_px", prior_center_px);
   positive("prior_focal_percent", prior_focal_percent);
+  if (!(surface_sigma_px >= 0 && std::isfinite(surface_sigma_px))) {
+    MR_THROW_INPUT << "CameraRefinementOptions::surface_sigma_px = " << surface_sigma_px
+                   << ". Violated constraint: 0 <= surface_sigma_px < inf";
+  }
   if (max_iterations < 1) {
     MR_THROW_INPUT << "CameraRefinementOptions::max_iterations = " << max_iterations
                    << ". Violated constraint: max_iterations >= 1";
@@ -474,6 +497,10 @@ struct CameraParameters {
   std::vector<int> block_of_view;
   std::vector<int> camera_of_block;
   std::vector<std::array<double, 2>> brightness;  // per ordered pair: a, b
+  // Per face (free surface only): the offset δ_f of its plane, and the 1-sigma
+  // of its prior (0 for faces without samples).
+  std::vector<double> surface_offset;
+  std::vector<double> surface_sigma;
 };
 
 // Rotations, centres and intrinsics blocks from the views; throws InputError
@@ -556,11 +583,28 @@ std::vector<OrderedPair> CollectSamples(const std::vector<cv::Mat>& gray_images,
 // photometric residuals of every sample and the priors of every view (and
 // camera) they involve, centred on `prior` (same layout as `params`).
 // `refined` receives which views take part.
+// With a free surface (options.surface_sigma_px > 0), every face with samples
+// gets a plane offset and its prior, and the offsets are what the Schur
+// complement eliminates; otherwise the brightness blocks are.
 void BuildProblem(const std::vector<cv::Mat>& gray_images, const std::vector<OrderedPair>& ordered,
-                  const std::vector<double>& footprint, const CameraRefinementOptions& options,
-                  const CameraParameters& prior, CameraParameters* params, ceres::Problem* problem,
+                  const std::vector<double>& footprint, int num_faces,
+                  const CameraRefinementOptions& options, const CameraParameters& prior,
+                  CameraParameters* params, ceres::Problem* problem,
                   ceres::ParameterBlockOrdering* ordering, std::vector<char>* refined) {
   CameraParameters& p = *params;
+  const bool free_surface = options.surface_sigma_px > 0;
+  if (free_surface) {
+    // σ_f from the finest view that samples the face.
+    p.surface_offset.assign(num_faces, 0.0);
+    p.surface_sigma.assign(num_faces, 0.0);
+    for (const OrderedPair& pair : ordered) {
+      for (const auto& sample : pair.samples) {
+        double& sigma = p.surface_sigma[sample.face];
+        const double s = options.surface_sigma_px * sample.footprint;
+        sigma = sigma == 0 ? s : std::min(sigma, s);
+      }
+    }
+  }
   // Huber on r with threshold huber_delta, weighed as residuals of std dev
   // intensity_sigma: ρ(r²) / σ².
   ceres::LossFunction* loss = new ceres::ScaledLoss(
@@ -571,21 +615,26 @@ void BuildProblem(const std::vector<cv::Mat>& gray_images, const std::vector<Ord
     const int i = ordered[k].i, j = ordered[k].j;
     const int bi = p.block_of_view[i], bj = p.block_of_view[j];
     for (const auto& sample : ordered[k].samples) {
-      if (bi == bj) {
-        problem->AddResidualBlock(internal::NewPhotometricCost(sample, gray_images[j], true), loss,
-                                  p.rotation[i].data(), p.center[i].data(), p.rotation[j].data(),
-                                  p.center[j].data(), p.intrinsics[bi].data(),
-                                  p.brightness[k].data());
-      } else {
-        problem->AddResidualBlock(internal::NewPhotometricCost(sample, gray_images[j], false), loss,
-                                  p.rotation[i].data(), p.center[i].data(), p.intrinsics[bi].data(),
-                                  p.rotation[j].data(), p.center[j].data(), p.intrinsics[bj].data(),
-                                  p.brightness[k].data());
-      }
+      std::vector<double*> blocks = {p.rotation[i].data(), p.center[i].data()};
+      if (bi != bj) blocks.push_back(p.intrinsics[bi].data());
+      blocks.insert(blocks.end(), {p.rotation[j].data(), p.center[j].data(),
+                                   p.intrinsics[bj].data(), p.brightness[k].data()});
+      if (free_surface) blocks.push_back(&p.surface_offset[sample.face]);
+      problem->AddResidualBlock(
+          internal::NewPhotometricCost(sample, gray_images[j], bi == bj, free_surface), loss,
+          blocks);
     }
     (*refined)[i] = (*refined)[j] = 1;
-    // The brightness blocks never share a residual: Schur eliminates them.
-    ordering->AddElementToGroup(p.brightness[k].data(), 0);
+    // Schur eliminates the offsets, which never share a residual with each
+    // other; without them, the brightness blocks, which never do either.
+    ordering->AddElementToGroup(p.brightness[k].data(), free_surface ? 1 : 0);
+  }
+  for (int f = 0; free_surface && f < num_faces; ++f) {
+    if (p.surface_sigma[f] == 0) continue;
+    problem->AddResidualBlock(new ceres::AutoDiffCostFunction<internal::OffsetPrior, 1, 1>(
+                                  new internal::OffsetPrior(p.surface_sigma[f])),
+                              nullptr, &p.surface_offset[f]);
+    ordering->AddElementToGroup(&p.surface_offset[f], 0);
   }
 
   ceres::Manifold* manifold = internal::NewRotationMatrixManifold();
@@ -698,8 +747,8 @@ CameraRefinementSummary RefineCameras(const std::vector<cv::Mat>& gray_images,
   ceres::Problem problem;
   auto ordering = std::make_shared<ceres::ParameterBlockOrdering>();
   std::vector<char> refined(num_views, 0);
-  BuildProblem(gray_images, ordered, summary.footprint, options, prior, &params, &problem,
-               ordering.get(), &refined);
+  BuildProblem(gray_images, ordered, summary.footprint, static_cast<int>(F.rows()), options,
+               prior, &params, &problem, ordering.get(), &refined);
   summary.num_views_refined = static_cast<int>(std::count(refined.begin(), refined.end(), 1));
 
   ceres::Solver::Options solver;
@@ -729,6 +778,19 @@ CameraRefinementSummary RefineCameras(const std::vector<cv::Mat>& gray_images,
     return summary;
   }
   WriteBack(params, refined, intrinsics, views, &summary);
+  std::vector<double> offsets_px;
+  for (size_t f = 0; f < params.surface_sigma.size(); ++f) {
+    if (params.surface_sigma[f] == 0) continue;
+    offsets_px.push_back(std::abs(params.surface_offset[f]) / params.surface_sigma[f] *
+                         options.surface_sigma_px);
+  }
+  summary.num_faces = static_cast<int>(offsets_px.size());
+  if (!offsets_px.empty()) {
+    summary.max_surface_offset_px = MaxOf(offsets_px);
+    std::nth_element(offsets_px.begin(), offsets_px.begin() + offsets_px.size() / 2,
+                     offsets_px.end());
+    summary.median_surface_offset_px = offsets_px[offsets_px.size() / 2];
+  }
   summary.seconds = ElapsedSeconds() - start_s;
 
   for (int i = 0; i < num_views; ++i) {
@@ -749,7 +811,13 @@ CameraRefinementSummary RefineCameras(const std::vector<cv::Mat>& gray_images,
 std::string CameraRefinementSummary::BriefReport() const {
   std::ostringstream out;
   out << "Camera refinement (" << mode << "): " << num_views_refined << " views, "
-      << num_ordered_pairs << " ordered pairs, " << num_samples << " samples; cost "
+      << num_ordered_pairs << " ordered pairs, " << num_samples << " samples";
+  if (num_faces > 0) {
+    out << ", " << num_faces << " face planes free (moved " << std::setprecision(3)
+        << median_surface_offset_px << " px footprints median, " << max_surface_offset_px
+        << " largest)";
+  }
+  out << "; cost "
       << std::setprecision(4) << initial_cost << " -> " << final_cost << " in " << iterations
       << " iterations" << (converged ? "" : " (not converged)") << "; largest change: rotation "
       << std::setprecision(3) << MaxOf(rotation_change_deg) << " deg, centre "

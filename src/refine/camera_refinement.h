@@ -18,6 +18,14 @@
 // and weighed as residuals of standard deviation intensity_sigma, plus
 // priors that keep each camera near its start (they hold the directions the
 // data barely sees, such as rotations about the centre of a sphere).
+//
+// The mesh is not exact (it was made with the wrong cameras), and cameras
+// fitted to a fixed wrong surface absorb its error. So by default each face's
+// plane may shift along its normal, n·X = n·A + δ_f, with δ_f shared by all
+// samples on face f from every pair and held near 0 by a prior of
+// surface_sigma_px pixel footprints: a photometric bundle adjustment whose
+// structure is the mesh's face planes. The cameras are then fixed by what the
+// views agree on, not by the mesh's depth.
 // The photometric Jacobian is analytic (see docs/camera_refinement.md).
 
 #include <Eigen/Core>
@@ -64,6 +72,15 @@ struct CameraRefinementOptions {
   // 1-sigma of the prior on fx and fy, in percent of the start (> 0;
   // poses_intrinsics only). The principal point has no prior of its own.
   double prior_focal_percent = 1.0;
+  // 1-sigma of the prior on each face's plane offset δ_f, in pixel footprints
+  // at the face (>= 0; of the finest view that samples it). 0 holds the mesh
+  // fixed: its face planes are taken as exact, and the cameras absorb the
+  // mesh's error. Larger values free the surface more but let faces whose
+  // images say little slide into false matches (100 moved exact cameras
+  // 0.6 px off on a noisy corpus case); 5 was chosen on the worst case of
+  // four corpus cases with exact and 1 px cameras and on templeSparseRing
+  // (docs/camera_refinement.md).
+  double surface_sigma_px = 5.0;
   // Ceres iterations (>= 1).
   int max_iterations = 30;
 
@@ -75,6 +92,11 @@ struct CameraRefinementSummary {
   int num_views_refined = 0;  // views in at least one pair with samples
   int num_ordered_pairs = 0;  // ordered pairs with samples
   long num_samples = 0;       // photometric residuals
+  // Faces whose plane offset was free (surface_sigma_px > 0), and the median
+  // and largest |δ_f| at the end, in pixel footprints.
+  int num_faces = 0;
+  double median_surface_offset_px = 0;
+  double max_surface_offset_px = 0;
   // Ceres's cost (photometric under the Huber loss, plus the priors), before
   // and after.
   double initial_cost = 0;
@@ -137,6 +159,8 @@ struct PhotometricSample {
   double plane_offset = 0;
   double intensity = 0;
   double score = 0;  // |∇I_j| at the projection (px⁻¹), what the selection ranks by
+  int face = -1;         // the face it sees
+  double footprint = 0;  // the point's depth in view i / fx_i (scene units per pixel)
 };
 
 // The samples of the ordered pair (i, j) as RefineCameras picks them:
@@ -156,14 +180,16 @@ std::vector<PhotometricSample> SelectSamples(const Eigen::MatrixXd& V, const Eig
                                              int max_samples);
 
 // The photometric residual r = I_j(q) - (a I_i(p) + b) of one sample as a
-// ceres::SizedCostFunction with analytic Jacobians. Parameter blocks, with
+// ceres::CostFunction with analytic Jacobians. Parameter blocks, with
 // rotations as row-major 3x3 cam_from_world matrices (9 values, with
 // RotationMatrixManifold) and intrinsics as (fx, fy, cx, cy):
 //   shared_intrinsics = false: R_i (9), C_i (3), K_i (4), R_j (9), C_j (3), K_j (4), (a, b)
 //   shared_intrinsics = true:  R_i (9), C_i (3), R_j (9), C_j (3), K (4), (a, b)
+// and with free_surface a last block (1): the offset δ of the sample's face
+// plane, n·X = plane_offset + δ.
 // `image_j` (CV_32F) must outlive the cost function (its data is shared).
 ceres::CostFunction* NewPhotometricCost(const PhotometricSample& sample, const cv::Mat& image_j,
-                                        bool shared_intrinsics);
+                                        bool shared_intrinsics, bool free_surface = false);
 
 // The rotation matrices (row-major, 9 values) with the tangent update
 // Plus(R, δ) = Exp(δ) R (δ an angle-axis vector in the camera frame).

@@ -1042,6 +1042,9 @@ void RegisterRefineOptions(OptionManager* o, RefineOptions* r) {
          "1-sigma of the prior on each camera centre (pixel footprints)");
   o->Add("CameraRefinement.prior_focal_percent", &r->camera_refinement.prior_focal_percent,
          "1-sigma of the prior on fx, fy (percent; poses_intrinsics)");
+  o->Add("CameraRefinement.surface_sigma_px", &r->camera_refinement.surface_sigma_px,
+         "1-sigma of the prior on each face plane's offset (pixel footprints); 0 holds the mesh "
+         "fixed");
   o->Add("CameraRefinement.max_iterations", &r->camera_refinement.max_iterations,
          "Ceres iterations (>= 1)");
   o->Add("Refine.noise_from_step", &r->noise_from_step,
