@@ -513,6 +513,31 @@ TEST_F(MeshRefinerCli, RefinedCamerasAreWrittenBesideTheModel) {
   EXPECT_LT(largest_move, 0.05);  // exact cameras stay put (scene radius 1, distance 4)
 }
 
+// --holdout_path scores the held-out views twice: at their SfM poses, and
+// registered to the refined model. With exact cameras both agree.
+TEST_F(MeshRefinerCli, HeldOutViewsAreScoredAtTheirPosesAndRegistered) {
+  TriangleMesh truth;
+  MakeBumpySphere(4, 0.06, &truth.V, &truth.F);
+  WritePly(dir_ + "/meshed-poisson.ply", truth);
+  std::ofstream(dir_ + "/holdout.txt") << "view_1.png\n";
+  const CommandResult r = RunCommand(kRefiner + " --workspace_path " + dir_ + " --holdout_path " +
+                                     dir_ + "/holdout.txt" + kFast);
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  double before = 0, after = 0, registered = 0;
+  const size_t at = r.output.find("Held-out photo-consistency (mean ZNCC, 1 views): ");
+  ASSERT_NE(at, std::string::npos) << r.output;
+  ASSERT_EQ(std::sscanf(r.output.c_str() + at, "Held-out photo-consistency (mean ZNCC, 1 views): "
+                        "%lf -> %lf", &before, &after), 2) << r.output;
+  const std::string line = "registered to the refined model (their poses refined against the "
+                           "mesh and the used views): ";
+  const size_t reg = r.output.find(line);
+  ASSERT_NE(reg, std::string::npos) << r.output;
+  ASSERT_EQ(std::sscanf(r.output.c_str() + reg + line.size(), "%lf", &registered), 1);
+  std::printf("held-out: %.4f -> %.4f, registered %.4f\n", before, after, registered);
+  EXPECT_GT(after, 0.5);
+  EXPECT_NEAR(registered, after, 0.02);
+}
+
 TEST_F(MeshRefinerCli, BadOptionNamesTheField) {
   const CommandResult r =
       RunCommand(kRefiner + " --workspace_path " + dir_ + " --Refine.similarity ssd");

@@ -5,7 +5,9 @@
 # with every 4th image held out, refined without and with
 # --Refine.refine_cameras. Reports:
 #   - held-out photo-consistency (mean ZNCC of the held-out images against
-#     their neighbours through the mesh) before and after refinement;
+#     their neighbours through the mesh) before and after refinement, with
+#     the held-out images at their SfM poses and registered to the refined
+#     model (mesh_refiner prints both);
 #   - how far COLMAP's cameras, and the refined ones, are from the data set's
 #     calibration (*_par.txt), after aligning each model to it with a
 #     similarity (colmap model_aligner on the camera centres): the RMS
@@ -77,13 +79,13 @@ align() {
     --true_sparse_path "$par/sparse" 2> /dev/null
 }
 
-printf '| run | mean similarity (all views used) | held-out photo-consistency | cameras vs calibration, RMS (worst image) px | time s |\n|---|---|---|---|---|\n' \
+printf '| run | mean similarity (all views used) | held-out photo-consistency, SfM poses | the same, held-out views registered | cameras vs calibration, RMS (worst image) px | time s |\n|---|---|---|---|---|---|\n' \
   > "$OUT/results.md"
 sfm=$(align "$undistorted/sparse" sfm)
 python3 - "$sfm" >> "$OUT/results.md" <<'EOF'
 import json, sys
 m = json.loads(sys.argv[1])
-print(f"| COLMAP SfM cameras, visual hull | | | {m['camera_rms_px']:.3f} ({m['camera_max_rms_px']:.3f}) | |")
+print(f"| COLMAP SfM cameras, visual hull | | | | {m['camera_rms_px']:.3f} ({m['camera_max_rms_px']:.3f}) | |")
 EOF
 while IFS= read -r config; do
   [ -z "$config" ] && continue
@@ -105,11 +107,12 @@ while IFS= read -r config; do
   [ -d "$OUT/sparse_refined_$label" ] && cameras="$OUT/sparse_refined_$label"
   json=$(align "$cameras" "$label")
   similarity=$(grep -o "mean similarity [-0-9.]* -> [-0-9.]*" "$OUT/$label.log" | tail -1 | cut -d' ' -f3-)
-  heldout=$(grep -o "Held-out photo-consistency.*" "$OUT/$label.log" | tail -1 | sed 's/.*: //')
-  python3 - "$json" "$label" "$similarity" "$heldout" "$(cat "$OUT/$label.time")" >> "$OUT/results.md" <<'EOF'
+  heldout=$(grep -o "Held-out photo-consistency (mean.*" "$OUT/$label.log" | tail -1 | sed 's/.*: //')
+  registered=$(grep -o "Held-out photo-consistency with.*" "$OUT/$label.log" | tail -1 | sed 's/.*: //')
+  python3 - "$json" "$label" "$similarity" "$heldout" "$(cat "$OUT/$label.time")" "$registered" >> "$OUT/results.md" <<'EOF'
 import json, sys
 m = json.loads(sys.argv[1])
-print(f"| mesh_refiner {sys.argv[2]} | {sys.argv[3]} | {sys.argv[4]} | "
+print(f"| mesh_refiner {sys.argv[2]} | {sys.argv[3]} | {sys.argv[4]} | {sys.argv[6]} | "
       f"{m['camera_rms_px']:.3f} ({m['camera_max_rms_px']:.3f}) | {float(sys.argv[5]):.0f} |")
 EOF
 done <<< "$CONFIGS"

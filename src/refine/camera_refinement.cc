@@ -463,8 +463,13 @@ void CheckInputs(const std::vector<cv::Mat>& gray_images,
     MR_THROW_INPUT << "RefineCameras: " << gray_images.size() << " images for " << num_views
                    << " views; expected one image per view";
   }
+  std::vector<char> involved(num_views, 0);
+  for (const auto& [i, j] : pairs) {
+    if (i >= 0 && j >= 0 && i < num_views && j < num_views) involved[i] = involved[j] = 1;
+  }
   for (int i = 0; i < num_views; ++i) {
     const cv::Mat& image = gray_images[i];
+    if (!involved[i] && image.empty()) continue;
     if (image.type() != CV_32F || image.cols != views[i].width || image.rows != views[i].height) {
       MR_THROW_INPUT << "RefineCameras: image " << i << " is " << image.cols << "x" << image.rows
                      << " of OpenCV type " << image.type() << "; expected CV_32F (type " << CV_32F
@@ -589,8 +594,9 @@ std::vector<OrderedPair> CollectSamples(const std::vector<cv::Mat>& gray_images,
 void BuildProblem(const std::vector<cv::Mat>& gray_images, const std::vector<OrderedPair>& ordered,
                   const std::vector<double>& footprint, int num_faces,
                   const CameraRefinementOptions& options, const CameraParameters& prior,
-                  CameraParameters* params, ceres::Problem* problem,
-                  ceres::ParameterBlockOrdering* ordering, std::vector<char>* refined) {
+                  const std::vector<char>& fixed, CameraParameters* params,
+                  ceres::Problem* problem, ceres::ParameterBlockOrdering* ordering,
+                  std::vector<char>* refined) {
   CameraParameters& p = *params;
   const bool free_surface = options.surface_sigma_px > 0;
   if (free_surface) {
@@ -624,7 +630,8 @@ void BuildProblem(const std::vector<cv::Mat>& gray_images, const std::vector<Ord
           internal::NewPhotometricCost(sample, gray_images[j], bi == bj, free_surface), loss,
           blocks);
     }
-    (*refined)[i] = (*refined)[j] = 1;
+    (*refined)[i] = !fixed[i];
+    (*refined)[j] = !fixed[j];
     // Schur eliminates the offsets, which never share a residual with each
     // other; without them, the brightness blocks, which never do either.
     ordering->AddElementToGroup(p.brightness[k].data(), free_surface ? 1 : 0);
@@ -639,6 +646,12 @@ void BuildProblem(const std::vector<cv::Mat>& gray_images, const std::vector<Ord
 
   ceres::Manifold* manifold = internal::NewRotationMatrixManifold();
   for (size_t i = 0; i < refined->size(); ++i) {
+    if (fixed[i] && problem->HasParameterBlock(p.rotation[i].data())) {
+      problem->SetParameterBlockConstant(p.rotation[i].data());
+      problem->SetParameterBlockConstant(p.center[i].data());
+      ordering->AddElementToGroup(p.rotation[i].data(), 1);
+      ordering->AddElementToGroup(p.center[i].data(), 1);
+    }
     if (!(*refined)[i]) continue;
     const Eigen::Matrix3d R0 = Eigen::Map<const internal::RowMatrix3d>(prior.rotation[i].data());
     const Eigen::Vector3d C0 = Eigen::Map<const Eigen::Vector3d>(prior.center[i].data());
@@ -655,11 +668,15 @@ void BuildProblem(const std::vector<cv::Mat>& gray_images, const std::vector<Ord
     ordering->AddElementToGroup(p.rotation[i].data(), 1);
     ordering->AddElementToGroup(p.center[i].data(), 1);
   }
+  std::vector<char> fixed_block(p.intrinsics.size(), 0);
+  for (size_t i = 0; i < fixed.size(); ++i) {
+    if (fixed[i]) fixed_block[p.block_of_view[i]] = 1;
+  }
   for (size_t b = 0; b < p.intrinsics.size(); ++b) {
     std::array<double, 4>& k = p.intrinsics[b];
     if (!problem->HasParameterBlock(k.data())) continue;
     ordering->AddElementToGroup(k.data(), 1);
-    if (options.mode != "poses_intrinsics") {
+    if (options.mode != "poses_intrinsics" || fixed_block[b]) {
       problem->SetParameterBlockConstant(k.data());
       continue;
     }
@@ -708,7 +725,8 @@ CameraRefinementSummary RefineCameras(const std::vector<cv::Mat>& gray_images,
                                       Renderer* renderer, const std::vector<int>& camera_of_view,
                                       const CameraRefinementOptions& options,
                                       std::vector<PinholeView>* views,
-                                      const std::vector<PinholeView>* prior_views) {
+                                      const std::vector<PinholeView>* prior_views,
+                                      const std::vector<char>* fixed_views) {
   options.Check();
   MR_CHECK(views != nullptr && renderer != nullptr);
   CheckInputs(gray_images, pairs, V, F, camera_of_view, *views);
@@ -720,6 +738,9 @@ CameraRefinementSummary RefineCameras(const std::vector<cv::Mat>& gray_images,
           << "view " << i << ": prior and start views differ in resolution";
     }
   }
+  if (fixed_views != nullptr) MR_CHECK_EQ(fixed_views->size(), views->size());
+  const std::vector<char> fixed =
+      fixed_views != nullptr ? *fixed_views : std::vector<char>(views->size(), 0);
   const double start_s = ElapsedSeconds();
   const int num_views = static_cast<int>(views->size());
   const bool intrinsics = options.mode == "poses_intrinsics";
@@ -733,8 +754,14 @@ CameraRefinementSummary RefineCameras(const std::vector<cv::Mat>& gray_images,
   CameraParameters params = InitialParameters(*views, camera_of_view, intrinsics);
   const CameraParameters prior =
       prior_views == nullptr ? params : InitialParameters(*prior_views, camera_of_view, intrinsics);
-  const std::vector<OrderedPair> ordered = CollectSamples(
-      gray_images, pairs, V, F, renderer, *views, options.max_samples_per_pair, &summary.footprint);
+  // A pair of two fixed views tells nothing.
+  std::vector<std::pair<int, int>> used_pairs;
+  for (const auto& [i, j] : pairs) {
+    if (!(fixed[i] && fixed[j])) used_pairs.emplace_back(i, j);
+  }
+  const std::vector<OrderedPair> ordered =
+      CollectSamples(gray_images, used_pairs, V, F, renderer, *views,
+                     options.max_samples_per_pair, &summary.footprint);
   summary.num_ordered_pairs = static_cast<int>(ordered.size());
   for (const OrderedPair& pair : ordered) summary.num_samples += pair.samples.size();
   if (ordered.empty()) {
@@ -748,7 +775,7 @@ CameraRefinementSummary RefineCameras(const std::vector<cv::Mat>& gray_images,
   auto ordering = std::make_shared<ceres::ParameterBlockOrdering>();
   std::vector<char> refined(num_views, 0);
   BuildProblem(gray_images, ordered, summary.footprint, static_cast<int>(F.rows()), options,
-               prior, &params, &problem, ordering.get(), &refined);
+               prior, fixed, &params, &problem, ordering.get(), &refined);
   summary.num_views_refined = static_cast<int>(std::count(refined.begin(), refined.end(), 1));
 
   ceres::Solver::Options solver;

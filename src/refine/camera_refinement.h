@@ -140,13 +140,18 @@ struct CameraRefinementSummary {
 // Returns with the cameras unchanged (and a WARNING) if no pair has samples
 // or Ceres finds no usable solution. Throws InputError on bad options or
 // inputs.
+// `fixed_views` (optional, one flag per view): views that keep their
+// camera and only anchor the others (e.g. to register new images against a
+// refined model); in poses_intrinsics the intrinsics of a camera with a
+// fixed view stay fixed too. Views in no pair may pass an empty image.
 CameraRefinementSummary RefineCameras(const std::vector<cv::Mat>& gray_images,
                                       const std::vector<std::pair<int, int>>& pairs,
                                       const Eigen::MatrixXd& V, const Eigen::MatrixXi& F,
                                       Renderer* renderer, const std::vector<int>& camera_of_view,
                                       const CameraRefinementOptions& options,
                                       std::vector<PinholeView>* views,
-                                      const std::vector<PinholeView>* prior_views = nullptr);
+                                      const std::vector<PinholeView>* prior_views = nullptr,
+                                      const std::vector<char>* fixed_views = nullptr);
 
 namespace internal {
 

@@ -86,6 +86,17 @@ class CameraRefinementTest : public ::testing::Test {
     renderer_ = nullptr;
   }
 
+  // The reprojection RMS (px) of view i's ground-truth vertices through `view`.
+  static double ViewRms(const PinholeView& view, int i) {
+    const Scene& s = *scene_;
+    double sum = 0;
+    for (int v : s.visible[i]) {
+      const Eigen::Vector3d X = s.V.row(v);
+      sum += (view.Project(X) - s.views[i].Project(X)).squaredNorm();
+    }
+    return std::sqrt(sum / s.visible[i].size());
+  }
+
   // RMS over the views of the reprojection error (px) of the ground-truth
   // vertices each view sees, `views` against the true views.
   static double ReprojectionRms(const std::vector<PinholeView>& views, double* max_view_rms) {
@@ -518,6 +529,45 @@ TEST_F(CameraRefinementTest, FreeFacePlanesKeepTheMeshErrorOutOfTheCameras) {
   // perturbation's common motion, which the cameras' priors hold).
   EXPECT_LT(rms[1][0], 0.7 * rms[0][0]);
   EXPECT_LT(rms[1][1], 0.8 * rms[0][1]);
+}
+
+// Fixed views keep their cameras and anchor the others: one view 1 px off
+// among true ones is registered back (as held-out images are registered
+// against a refined model); views in no pair may come without an image.
+TEST_F(CameraRefinementTest, FixedViewsAnchorTheOthers) {
+  const Scene& s = *scene_;
+  const std::vector<PinholeView> perturbed = PerturbPoses(1.0, 13, false);
+  std::vector<PinholeView> views = s.views;
+  views[2] = perturbed[2];
+  std::vector<char> fixed(views.size(), 1);
+  fixed[2] = 0;
+  const double before = ViewRms(views[2], 2);
+  std::vector<cv::Mat> images = s.images;
+  std::vector<std::pair<int, int>> pairs;
+  for (const auto& [i, j] : s.pairs) {
+    if (i == 2 || j == 2) pairs.emplace_back(i, j);
+  }
+  std::vector<char> involved(views.size(), 0);
+  for (const auto& [i, j] : pairs) involved[i] = involved[j] = 1;
+  for (size_t i = 0; i < views.size(); ++i) {
+    if (!involved[i]) images[i] = cv::Mat();
+  }
+  CameraRefinementOptions options;
+  options.mode = "poses_intrinsics";  // the shared camera has fixed views: it stays
+  const CameraRefinementSummary summary = RefineCameras(
+      images, pairs, s.V, s.F, renderer_, std::vector<int>(views.size(), 1), options, &views,
+      nullptr, &fixed);
+  const double after = ViewRms(views[2], 2);
+  std::printf("%s\nthe free view: %.3f -> %.3f px\n", summary.BriefReport().c_str(), before, after);
+  EXPECT_EQ(summary.num_views_refined, 1);
+  EXPECT_GT(before, 0.5);
+  EXPECT_LT(after, 0.15);
+  for (size_t i = 0; i < views.size(); ++i) {
+    EXPECT_EQ(views[i].fx, s.views[i].fx);
+    if (i == 2) continue;
+    EXPECT_EQ(views[i].R, s.views[i].R);
+    EXPECT_EQ(views[i].t, s.views[i].t);
+  }
 }
 
 TEST(CameraRefinementOptions, DefaultsAreValid) { EXPECT_TRUE(CameraRefinementOptions().Check()); }
