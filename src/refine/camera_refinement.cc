@@ -426,6 +426,10 @@ bool CameraRefinementOptions::Check() const {
     MR_THROW_INPUT << "CameraRefinementOptions::surface_sigma_px = " << surface_sigma_px
                    << ". Violated constraint: 0 <= surface_sigma_px < inf";
   }
+  if (!(function_tolerance > 0 && function_tolerance < 1)) {
+    MR_THROW_INPUT << "CameraRefinementOptions::function_tolerance = " << function_tolerance
+                   << ". Violated constraint: 0 < function_tolerance < 1";
+  }
   if (max_iterations < 1) {
     MR_THROW_INPUT << "CameraRefinementOptions::max_iterations = " << max_iterations
                    << ". Violated constraint: max_iterations >= 1";
@@ -738,7 +742,9 @@ CameraRefinementSummary RefineCameras(const std::vector<cv::Mat>& gray_images,
           << "view " << i << ": prior and start views differ in resolution";
     }
   }
-  if (fixed_views != nullptr) MR_CHECK_EQ(fixed_views->size(), views->size());
+  if (fixed_views != nullptr) {
+    MR_CHECK_EQ(fixed_views->size(), views->size());
+  }
   const std::vector<char> fixed =
       fixed_views != nullptr ? *fixed_views : std::vector<char>(views->size(), 0);
   const double start_s = ElapsedSeconds();
@@ -787,6 +793,7 @@ CameraRefinementSummary RefineCameras(const std::vector<cv::Mat>& gray_images,
           : ceres::SPARSE_SCHUR;
   solver.linear_solver_ordering = ordering;
   solver.max_num_iterations = options.max_iterations;
+  solver.function_tolerance = options.function_tolerance;
   solver.num_threads = 1;
   solver.logging_type = ceres::SILENT;
   ceres::Solver::Summary ceres_summary;

@@ -83,6 +83,12 @@ struct CameraRefinementOptions {
   double surface_sigma_px = 5.0;
   // Ceres iterations (>= 1).
   int max_iterations = 30;
+  // Ceres stops when an iteration lowers the cost by less than this fraction
+  // (0 < function_tolerance < 1). 1e-3 against Ceres's 1e-6: on four corpus
+  // cases with exact and 1 px cameras the worst case was as good or better
+  // (accuracy90 1.006x / 2.097x the exact-camera run against 1.012x /
+  // 2.102x) in 4-17 iterations instead of 23-31, 2-3x faster.
+  double function_tolerance = 1e-3;
 
   bool Check() const;
 };

@@ -1047,6 +1047,8 @@ void RegisterRefineOptions(OptionManager* o, RefineOptions* r) {
          "fixed");
   o->Add("CameraRefinement.max_iterations", &r->camera_refinement.max_iterations,
          "Ceres iterations (>= 1)");
+  o->Add("CameraRefinement.function_tolerance", &r->camera_refinement.function_tolerance,
+         "Ceres stops when an iteration lowers the cost by less than this fraction");
   o->Add("Refine.noise_from_step", &r->noise_from_step,
          "lp proximal step: noise estimated from what the gradient step added, not the surface");
   o->Add("Refine.silhouette_weight", &r->silhouette_weight,
