@@ -72,8 +72,4 @@ VisualHullSummary ComputeVisualHull(const std::vector<PinholeView>& views,
 // optical axes. Throws InputError if the views share no region.
 Eigen::AlignedBox3d FrustumIntersectionBox(const std::vector<PinholeView>& views);
 
-// Signed distance in pixels to the boundary of a mask (positive inside, 0 on
-// the boundary between a foreground and a background pixel), CV_32F.
-cv::Mat MaskSignedDistance(const cv::Mat& mask);
-
 }  // namespace mr

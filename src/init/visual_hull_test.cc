@@ -8,6 +8,7 @@
 
 #include "init/isosurface.h"
 #include "util/error.h"
+#include "util/mask_distance.h"
 
 namespace mr {
 namespace {

@@ -10,6 +10,7 @@
 #include "render/renderer.h"
 #include "util/error.h"
 #include "util/logging.h"
+#include "util/mask_distance.h"
 
 namespace mr {
 
@@ -221,21 +222,17 @@ cv::Mat BackgroundMaskedViewSource::LoadMask(int i) const {
 
 cv::Mat LimitToOutlineBand(const cv::Mat& mask, const cv::Mat& covered, double max_offset_px) {
   MR_CHECK(mask.size() == covered.size() && mask.type() == CV_8U && covered.type() == CV_8U);
-  // Distance of each pixel to the nearest pixel on the other side of the
-  // outline of `covered`.
-  cv::Mat inside, outside;
-  const cv::Mat in = covered > 0;
-  cv::distanceTransform(in, inside, cv::DIST_L2, cv::DIST_MASK_PRECISE);
-  cv::distanceTransform(~in, outside, cv::DIST_L2, cv::DIST_MASK_PRECISE);
-  cv::Mat out = in.clone();
+  // |sdf| + 0.5: the distance of each pixel to the nearest pixel on the other
+  // side of the outline of `covered`.
+  const cv::Mat sdf = MaskSignedDistance(covered);
+  cv::Mat out = covered > 0;
   for (int r = 0; r < out.rows; ++r) {
     const uchar* m = mask.ptr<uchar>(r);
-    const float* di = inside.ptr<float>(r);
-    const float* dout = outside.ptr<float>(r);
+    const float* d = sdf.ptr<float>(r);
     uchar* o = out.ptr<uchar>(r);
     for (int c = 0; c < out.cols; ++c) {
       const bool object = m[c] > 0;
-      if (object != (o[c] > 0) && (o[c] ? di[c] : dout[c]) <= max_offset_px) {
+      if (object != (o[c] > 0) && std::abs(d[c]) + 0.5f <= max_offset_px) {
         o[c] = object ? 255 : 0;
       }
     }
