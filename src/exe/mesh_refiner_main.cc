@@ -82,8 +82,8 @@ Reconstruction RefinedModel(const Workspace& workspace, const WorkspaceViewSourc
 
 // The views of `source` registered against the mesh (V, F), held fixed:
 // every view not in `fixed` gets its pose refined against its neighbours,
-// which keep theirs (as new images are registered to a model). Returns the workspace's model
-// with the registered poses and logs one line.
+// which keep theirs (as new images are registered to a model). Returns the
+// workspace's model with the registered poses and logs one line.
 Reconstruction RegisterViews(const Workspace& workspace, const WorkspaceViewSource& source,
                              const std::vector<char>& fixed, const Eigen::MatrixXd& V,
                              const Eigen::MatrixXi& F, const CameraRefinementOptions& options,
@@ -95,7 +95,8 @@ Reconstruction RegisterViews(const Workspace& workspace, const WorkspaceViewSour
   std::vector<cv::Mat> images(views.size());
   std::vector<int> camera_of_view;
   for (int i = 0; i < source.NumViews(); ++i) {
-    camera_of_view.push_back(static_cast<int>(workspace.model.images.at(source.ImageId(i)).camera_id));
+    const Image& image = workspace.model.images.at(source.ImageId(i));
+    camera_of_view.push_back(static_cast<int>(image.camera_id));
     if (fixed[i]) continue;
     for (int j : neighbors[i]) {
       if (fixed[j]) pairs.emplace_back(i, j);
@@ -307,22 +308,20 @@ int Run(int argc, char** argv) {
         PhotoConsistency(refined_views, holdout_views, mesh.V, mesh.F, &renderer);
     std::printf("Held-out photo-consistency (mean ZNCC, %zu views): %.4f -> %.4f\n",
                 holdout_views.size(), holdout_before, after);
-    {
-      // The held-out views carry the SfM model's errors (and, when the used
-      // cameras were refined, the old datum). Registered against the refined
-      // model, as a new image would be, they judge the surface rather than
-      // the cameras.
-      std::vector<char> fixed(refined_views.NumViews(), 1);
-      for (int i : holdout_views) fixed[i] = 0;
-      Workspace registered = refined;
-      registered.model = RegisterViews(refined, refined_views, fixed, mesh.V, mesh.F,
-                                       refine.camera_refinement, &renderer);
-      const double registered_after = PhotoConsistency(WorkspaceViewSource(registered),
-                                                       holdout_views, mesh.V, mesh.F, &renderer);
-      std::printf("Held-out photo-consistency with the held-out views registered to the refined "
-                  "model (their poses refined against the mesh and the used views): %.4f\n",
-                  registered_after);
-    }
+    // The held-out views carry the SfM model's errors (and, when the used
+    // cameras were refined, the old datum). Registered against the refined
+    // model, as a new image would be, they judge the surface rather than the
+    // cameras.
+    std::vector<char> fixed(refined_views.NumViews(), 1);
+    for (int i : holdout_views) fixed[i] = 0;
+    Workspace registered = refined;
+    registered.model = RegisterViews(refined, refined_views, fixed, mesh.V, mesh.F,
+                                     refine.camera_refinement, &renderer);
+    const double registered_after = PhotoConsistency(WorkspaceViewSource(registered),
+                                                     holdout_views, mesh.V, mesh.F, &renderer);
+    std::printf("Held-out photo-consistency with the held-out views registered to the refined "
+                "model (their poses refined against the mesh and the used views): %.4f\n",
+                registered_after);
   }
   return 0;
 }
