@@ -370,7 +370,7 @@ std::vector<PhotometricSample> SelectSamples(const Eigen::MatrixXd& V, const Eig
       s.intensity = image_i.at<float>(r, c);
       s.score = score;
       s.face = f;
-      s.footprint = view_i.WorldToCamera(X).z() / view_i.fx;
+      s.footprint = d / view_i.fx;  // d is the depth: the ray has z = 1 in view i
       candidates.push_back(s);
     }
   }
