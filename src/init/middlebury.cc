@@ -13,6 +13,7 @@
 #include <opencv2/imgproc.hpp>
 
 #include "colmap_io/image_file.h"
+#include "util/components.h"
 #include "util/error.h"
 #include "util/file.h"
 #include "util/logging.h"
@@ -215,27 +216,23 @@ cv::Mat ComputeSilhouette(const cv::Mat& image, const SilhouetteOptions& options
   if (options.erode_px > 0) cv::erode(mask, mask, disc(options.erode_px));
   SilhouetteStats local;
   if (options.fill_holes_px > 0) {
-    // Background is 4-connected where the foreground is 8-connected.
-    cv::Mat labels, comp_stats, centroids;
-    const cv::Mat background = mask == 0;
-    const int n = cv::connectedComponentsWithStats(background, labels, comp_stats, centroids, 4);
-    std::vector<uchar> fill(n, 0);
-    for (int c = 1; c < n; ++c) {
-      const int x = comp_stats.at<int>(c, cv::CC_STAT_LEFT);
-      const int y = comp_stats.at<int>(c, cv::CC_STAT_TOP);
-      const int w = comp_stats.at<int>(c, cv::CC_STAT_WIDTH);
-      const int h = comp_stats.at<int>(c, cv::CC_STAT_HEIGHT);
-      const int area = comp_stats.at<int>(c, cv::CC_STAT_AREA);
-      if (x == 0 || y == 0 || x + w == mask.cols || y + h == mask.rows) continue;  // not a hole
-      if (area <= options.fill_holes_px) {
-        fill[c] = 1;
-        ++local.filled_holes;
-        local.largest_filled = std::max(local.largest_filled, area);
-      } else {
-        ++local.kept_holes;
-        local.smallest_kept = local.smallest_kept == 0 ? area : std::min(local.smallest_kept, area);
-      }
-    }
+    // Background is 4-connected where the foreground is 8-connected; a
+    // background component off the border is a hole.
+    cv::Mat labels;
+    const std::vector<uchar> fill = SelectComponents(
+        mask == 0, 4,
+        [&](bool touches, int area) {
+          if (touches) return false;
+          if (area <= options.fill_holes_px) {
+            ++local.filled_holes;
+            local.largest_filled = std::max(local.largest_filled, area);
+            return true;
+          }
+          ++local.kept_holes;
+          local.smallest_kept = local.smallest_kept == 0 ? area : std::min(local.smallest_kept, area);
+          return false;
+        },
+        &labels);
     if (local.filled_holes > 0) {
       for (int r = 0; r < mask.rows; ++r) {
         const int* l = labels.ptr<int>(r);

@@ -10,6 +10,7 @@
 #include "render/renderer.h"
 #include "util/error.h"
 #include "util/logging.h"
+#include "util/components.h"
 #include "util/mask_distance.h"
 
 namespace mr {
@@ -126,21 +127,10 @@ cv::Mat MaskOfFiltered(const cv::Mat& filtered, const BackgroundModel& model,
   // Background is 4-connected, the object 8-connected. A background-coloured
   // region is background where it touches the border or is a large hole;
   // an object region smaller than min_object_px is noise.
-  cv::Mat labels, stats, centroids;
-  auto label = [&](const cv::Mat& binary, int connectivity, auto keep) {
-    const int n = cv::connectedComponentsWithStats(binary, labels, stats, centroids, connectivity);
-    std::vector<uchar> kept(n, 0);
-    for (int k = 1; k < n; ++k) {
-      const int x = stats.at<int>(k, cv::CC_STAT_LEFT), y = stats.at<int>(k, cv::CC_STAT_TOP);
-      const int w = stats.at<int>(k, cv::CC_STAT_WIDTH), h = stats.at<int>(k, cv::CC_STAT_HEIGHT);
-      const bool touches = x == 0 || y == 0 || x + w == cols || y + h == rows;
-      kept[k] = keep(touches, stats.at<int>(k, cv::CC_STAT_AREA)) ? 1 : 0;
-    }
-    return kept;
-  };
+  cv::Mat labels;
   const double min_hole = options.min_hole_share * rows * cols;
-  const std::vector<uchar> background =
-      label(like, 4, [&](bool touches, int area) { return touches || area >= min_hole; });
+  const std::vector<uchar> background = SelectComponents(
+      like, 4, [&](bool touches, int area) { return touches || area >= min_hole; }, &labels);
   cv::Mat mask(filtered.size(), CV_8U);
   for (int r = 0; r < rows; ++r) {
     const int* l = labels.ptr<int>(r);
@@ -148,8 +138,8 @@ cv::Mat MaskOfFiltered(const cv::Mat& filtered, const BackgroundModel& model,
     uchar* m = mask.ptr<uchar>(r);
     for (int c = 0; c < cols; ++c) m[c] = is_like[c] && background[l[c]] ? 0 : 255;
   }
-  const std::vector<uchar> object =
-      label(mask, 8, [&](bool, int area) { return area >= options.min_object_px; });
+  const std::vector<uchar> object = SelectComponents(
+      mask, 8, [&](bool, int area) { return area >= options.min_object_px; }, &labels);
   for (int r = 0; r < rows; ++r) {
     const int* l = labels.ptr<int>(r);
     uchar* m = mask.ptr<uchar>(r);

@@ -458,6 +458,16 @@ double MedianFootprint(const PinholeView& view, const RenderBuffers& render) {
   return depths[depths.size() / 2] / view.fx;
 }
 
+// Which of `num_views` views take part in a pair (pairs naming a view out of
+// range are left to CheckInputs).
+std::vector<char> ViewsInPairs(const std::vector<std::pair<int, int>>& pairs, int num_views) {
+  std::vector<char> involved(num_views, 0);
+  for (const auto& [i, j] : pairs) {
+    if (i >= 0 && j >= 0 && i < num_views && j < num_views) involved[i] = involved[j] = 1;
+  }
+  return involved;
+}
+
 void CheckInputs(const std::vector<cv::Mat>& gray_images,
                  const std::vector<std::pair<int, int>>& pairs, const Eigen::MatrixXd& V,
                  const Eigen::MatrixXi& F, const std::vector<int>& camera_of_view,
@@ -467,10 +477,7 @@ void CheckInputs(const std::vector<cv::Mat>& gray_images,
     MR_THROW_INPUT << "RefineCameras: " << gray_images.size() << " images for " << num_views
                    << " views; expected one image per view";
   }
-  std::vector<char> involved(num_views, 0);
-  for (const auto& [i, j] : pairs) {
-    if (i >= 0 && j >= 0 && i < num_views && j < num_views) involved[i] = involved[j] = 1;
-  }
+  const std::vector<char> involved = ViewsInPairs(pairs, num_views);
   for (int i = 0; i < num_views; ++i) {
     const cv::Mat& image = gray_images[i];
     if (!involved[i] && image.empty()) continue;
@@ -564,8 +571,7 @@ std::vector<OrderedPair> CollectSamples(const std::vector<cv::Mat>& gray_images,
                                         Renderer* renderer, const std::vector<PinholeView>& views,
                                         int max_samples, std::vector<double>* footprint) {
   const int num_views = static_cast<int>(views.size());
-  std::vector<char> involved(num_views, 0);
-  for (const auto& [i, j] : pairs) involved[i] = involved[j] = 1;
+  const std::vector<char> involved = ViewsInPairs(pairs, num_views);
   renderer->SetMesh(V, F);
   std::vector<RenderBuffers> renders(num_views);
   for (int i = 0; i < num_views; ++i) {
