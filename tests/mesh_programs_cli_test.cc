@@ -170,6 +170,26 @@ TEST_F(MeshProgramsCli, EvaluatorComparesCamerasWithTheTrueOnes) {
       << off.output;
   EXPECT_EQ(number(off.output, "camera_max_focal_percent"), 0);
   EXPECT_NE(off.output.find("\"accuracy90\": "), std::string::npos) << off.output;
+
+  // --align_cameras: both cameras moved 0.02 units along world x (the world
+  // moved, a gauge change) compare as equal once aligned, and the alignment
+  // says how far it carried them; without it they are 2 px off.
+  Reconstruction shifted = truth;
+  for (auto& [id, image] : shifted.images) {
+    image.tvec -= QuaternionToRotation(image.qvec) * Eigen::Vector3d(0.02, 0, 0);
+  }
+  fs::create_directories(dir_ + "/shifted");
+  WriteSparseModelBinary(dir_ + "/shifted", shifted);
+  const CommandResult raw = RunCommand(evaluate + " --sparse_path " + dir_ + "/shifted");
+  ASSERT_EQ(raw.exit_code, 0) << raw.output;
+  EXPECT_GT(number(raw.output, "camera_rms_px"), 1) << raw.output;
+  const CommandResult aligned =
+      RunCommand(evaluate + " --sparse_path " + dir_ + "/shifted --align_cameras 1");
+  ASSERT_EQ(aligned.exit_code, 0) << aligned.output;
+  EXPECT_LT(number(aligned.output, "camera_rms_px"), 1e-4) << aligned.output;
+  EXPECT_NEAR(number(aligned.output, "alignment_shift"), 0.02, 1e-5) << aligned.output;
+  EXPECT_NEAR(number(aligned.output, "alignment_scale"), 1, 1e-5) << aligned.output;
+  EXPECT_LT(number(aligned.output, "alignment_rotation_deg"), 1e-3) << aligned.output;
 }
 
 TEST_F(MeshProgramsCli, OtherProgramsWriteConfigOverInputIsRefused) {

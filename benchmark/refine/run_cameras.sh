@@ -7,7 +7,10 @@
 # then mesh_refiner without and with camera refinement, then mesh_evaluator
 # on the observed surface and on the cameras (the refined model, or the input
 # one without refinement, against the true one: RMS reprojection displacement
-# of the ground-truth vertices each true view sees). Prints a markdown table
+# of the ground-truth vertices each true view sees), once as they are and once
+# datum-aligned (mesh_evaluator --align_cameras: mesh and cameras carried into
+# the true world by the similarity that best aligns the cameras, the gauge
+# that independent pose errors move and no refinement can know). Prints a markdown table
 # (benchmark/refine/camera_table.py). Results in OUT_DIR are reused.
 #
 #   bash benchmark/refine/run_cameras.sh OUT_DIR [case ...]
@@ -51,38 +54,45 @@ for name in $cases; do
     fi
     truth="$ws/sparse_true"
     [ -d "$truth" ] || truth="$ws/dense/sparse"
-    evaluate() {  # mesh cameras -> json on stdout
-      "$BIN/mesh_evaluator" --input_path "$1" --gt_path "$ws/ground_truth.ply" \
-        --workspace_path "$ws/dense" --sparse_path "$2" --true_sparse_path "$truth"
+    evaluate() {  # mesh cameras stem: STEM.json as it is, STEM.aligned.json datum-aligned
+      if [ ! -f "$3.json" ]; then
+        "$BIN/mesh_evaluator" --input_path "$1" --gt_path "$ws/ground_truth.ply" \
+          --workspace_path "$ws/dense" --sparse_path "$2" --true_sparse_path "$truth" > "$3.json"
+      fi
+      if [ ! -f "$3.aligned.json" ]; then
+        "$BIN/mesh_evaluator" --input_path "$1" --gt_path "$ws/ground_truth.ply" \
+          --workspace_path "$ws/dense" --sparse_path "$2" --true_sparse_path "$truth" \
+          --align_cameras 1 > "$3.aligned.json"
+      fi
     }
-    if [ ! -f "$ws.input.json" ]; then
-      evaluate "$ws/dense/meshed-poisson.ply" "$ws/dense/sparse" > "$ws.input.json"
-    fi
-    printf '%s\t%s\tinput\t%s\t0\t0\n' "$name" "$lname" "$(cat "$ws.input.json")" >> "$TSV"
+    evaluate "$ws/dense/meshed-poisson.ply" "$ws/dense/sparse" "$ws.input"
+    printf '%s\t%s\tinput\t%s\t%s\t0\t0\n' "$name" "$lname" "$(cat "$ws.input.json")" \
+      "$(cat "$ws.input.aligned.json")" >> "$TSV"
     while IFS= read -r config; do
       [ -z "$config" ] && continue
       label=${config%%|*}
       rflags=${config#*|}
       wanted "$lname" "$label" || continue
       stem="$ws.$label"
-      if [ ! -f "$stem.json" ]; then
+      if [ ! -f "$stem.time" ]; then
         echo "[$(date +%T)] $name ($lname): $label" >&2
         rm -rf "$ws/dense/sparse_refined"
         # shellcheck disable=SC2086
         /usr/bin/time -f "%e %M" -o "$stem.time" "$BIN/mesh_refiner" --workspace_path "$ws/dense" \
           --output_path "$ws/dense/meshed-refined-$label.ply" $rflags > "$stem.log" 2>&1 || {
+            rm -f "$stem.time"
             echo "mesh_refiner failed on $name ($lname, $label): see $stem.log" >&2; continue; }
-        cameras="$ws/dense/sparse"
+        rm -rf "$ws/dense/sparse_refined-$label" "$stem.json" "$stem.aligned.json"
         if [ -d "$ws/dense/sparse_refined" ]; then
-          rm -rf "$ws/dense/sparse_refined-$label"
           mv "$ws/dense/sparse_refined" "$ws/dense/sparse_refined-$label"
-          cameras="$ws/dense/sparse_refined-$label"
         fi
-        evaluate "$ws/dense/meshed-refined-$label.ply" "$cameras" > "$stem.json"
       fi
+      cameras="$ws/dense/sparse_refined-$label"
+      [ -d "$cameras" ] || cameras="$ws/dense/sparse"
+      evaluate "$ws/dense/meshed-refined-$label.ply" "$cameras" "$stem"
       read -r secs kb < "$stem.time"
-      printf '%s\t%s\t%s\t%s\t%s\t%s\n' "$name" "$lname" "$label" "$(cat "$stem.json")" \
-        "$secs" "$((kb / 1024))" >> "$TSV"
+      printf '%s\t%s\t%s\t%s\t%s\t%s\t%s\n' "$name" "$lname" "$label" "$(cat "$stem.json")" \
+        "$(cat "$stem.aligned.json")" "$secs" "$((kb / 1024))" >> "$TSV"
     done <<< "$CONFIGS"
   done <<< "$LEVELS"
 done

@@ -4,12 +4,16 @@
 //   mesh_evaluator --input_path meshed-refined.ply --gt_path gt.ply
 //       [--threshold 1.25] [--num_samples 200000] [--seed 1]
 //       [--workspace_path dense/] [--sparse_path dense/sparse_refined
-//        --true_sparse_path sparse_true]
+//        --true_sparse_path sparse_true [--align_cameras 1]]
 
+#include <cmath>
 #include <exception>
+#include <sstream>
 #include <iostream>
 #include <string>
 #include <vector>
+
+#include <Eigen/Geometry>
 
 #include "colmap_io/mesh_io.h"
 #include "colmap_io/sparse_model.h"
@@ -56,6 +60,11 @@ int main(int argc, char** argv) {
     manager.Add("true_sparse_path", &true_sparse_path,
                 "the true COLMAP model (e.g. workspace_synthesizer's sparse_true/); images "
                 "matched by name");
+    bool align_cameras = false;
+    manager.Add("align_cameras", &align_cameras,
+                "with --sparse_path: first carry the mesh and the model's cameras into the true "
+                "world by the similarity that best aligns the cameras with the true ones (the "
+                "gauge an SfM model leaves free; alignment_* in the JSON)");
     manager.SetInputPaths([&] {
       mr::WorkspaceOptions ws_options;
       ws_options.use_masks = false;
@@ -85,7 +94,10 @@ int main(int argc, char** argv) {
     for (const std::string& dir : {sparse_path, true_sparse_path}) {
       if (!dir.empty() && !mr::ExistsDir(dir)) MR_THROW_INPUT << dir << ": folder does not exist";
     }
-    const mr::TriangleMesh mesh = mr::ReadMesh(input_path);
+    if (align_cameras && sparse_path.empty()) {
+      MR_THROW_INPUT << "--align_cameras needs --sparse_path and --true_sparse_path";
+    }
+    mr::TriangleMesh mesh = mr::ReadMesh(input_path);
     const mr::TriangleMesh gt = mr::ReadMesh(gt_path);
     if (mesh.NumFaces() == 0) MR_THROW_INPUT << input_path << ": mesh has no faces";
     if (gt.NumFaces() == 0) MR_THROW_INPUT << gt_path << ": mesh has no faces";
@@ -102,13 +114,32 @@ int main(int argc, char** argv) {
       }
       observed = mr::ObservedFaces(gt.V, gt.F, views, min_views);
     }
+    mr::Reconstruction model, truth;
+    mr::Similarity3 model_to_truth;
+    if (!sparse_path.empty()) {
+      model = mr::ReadSparseModel(sparse_path);
+      truth = mr::ReadSparseModel(true_sparse_path);
+      if (align_cameras) {
+        model_to_truth = mr::AlignCamerasToTruth(model, truth, gt.V);
+        mesh.V = model_to_truth.Apply(mesh.V);
+      }
+    }
     const mr::EvaluationResult result = mr::EvaluateMesh(mesh.V, mesh.F, gt.V, gt.F, options,
                                                          observed.empty() ? nullptr : &observed);
     std::string json = result.ToJson();
     if (!sparse_path.empty()) {
-      const mr::CameraComparison cameras = mr::CompareCameras(
-          mr::ReadSparseModel(sparse_path), mr::ReadSparseModel(true_sparse_path), gt.V);
+      const mr::CameraComparison cameras =
+          mr::CompareCameras(model, truth, gt.V, align_cameras ? &model_to_truth : nullptr);
       json.insert(json.size() - 1, ", " + cameras.JsonMembers());
+      if (align_cameras) {
+        const Eigen::AngleAxisd angle(model_to_truth.rotation);
+        std::ostringstream s;
+        s.precision(6);
+        s << ", \"alignment_scale\": " << model_to_truth.scale
+          << ", \"alignment_rotation_deg\": " << angle.angle() * 180 / M_PI
+          << ", \"alignment_shift\": " << model_to_truth.translation.norm();
+        json.insert(json.size() - 1, s.str());
+      }
     }
     std::cout << json << std::endl;
     return 0;

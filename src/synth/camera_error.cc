@@ -9,6 +9,8 @@
 #include <utility>
 
 #include <Eigen/Geometry>
+#include <ceres/ceres.h>
+#include <ceres/rotation.h>
 
 #include "colmap_io/camera_models.h"
 #include "util/error.h"
@@ -238,13 +240,20 @@ std::string CameraComparison::JsonMembers() const {
   return s.str();
 }
 
-CameraComparison CompareCameras(const Reconstruction& model, const Reconstruction& truth,
-                                const Eigen::MatrixXd& surface_points) {
+namespace {
+
+// The views of the images of `model` and of their namesakes in `truth`, and
+// the (model, true) camera ids of each.
+struct MatchedViews {
+  std::vector<std::string> names;
+  std::vector<PinholeView> model, truth;
+  std::vector<std::pair<uint32_t, uint32_t>> camera_ids;
+};
+
+MatchedViews MatchViews(const Reconstruction& model, const Reconstruction& truth) {
   std::map<std::string, const Image*> true_by_name;
   for (const auto& [id, image] : truth.images) true_by_name[image.name] = &image;
-  CameraComparison comparison;
-  double sum_sq = 0;
-  std::set<std::pair<uint32_t, uint32_t>> cameras_seen;  // (model, true) camera ids
+  MatchedViews matched;
   for (const auto& [id, image] : model.images) {
     const auto match = true_by_name.find(image.name);
     if (match == true_by_name.end()) {
@@ -252,18 +261,139 @@ CameraComparison CompareCameras(const Reconstruction& model, const Reconstructio
                      << ") is not in the true model";
     }
     const Image& true_image = *match->second;
-    const Camera& camera = model.cameras.at(image.camera_id);
-    const Camera& true_camera = truth.cameras.at(true_image.camera_id);
-    const PinholeView view = ViewFromColmap(camera, image);
-    const PinholeView true_view = ViewFromColmap(true_camera, true_image);
+    matched.names.push_back(image.name);
+    matched.model.push_back(ViewFromColmap(model.cameras.at(image.camera_id), image));
+    matched.truth.push_back(ViewFromColmap(truth.cameras.at(true_image.camera_id), true_image));
+    matched.camera_ids.emplace_back(image.camera_id, true_image.camera_id);
+  }
+  return matched;
+}
+
+// Residual of AlignCamerasToTruth: the projection of true point X through the
+// model's view carried into the true world by the similarity (angle-axis
+// rotation, translation, log scale) minus its true projection.
+struct AlignmentResidual {
+  AlignmentResidual(const PinholeView& view, const Eigen::Vector3d& X, const Eigen::Vector2d& x)
+      : view(view), X(X), x(x) {}
+
+  template <typename T>
+  bool operator()(const T* rotation, const T* translation, const T* log_scale, T* residual) const {
+    // The carried view sees X where the model's view saw Rᵀ (X - t) / s; the
+    // scale drops out of the projection, so R_i Rᵀ (X - t) + s t_i is used.
+    const T shifted[3] = {T(X.x()) - translation[0], T(X.y()) - translation[1],
+                          T(X.z()) - translation[2]};
+    const T inverse[3] = {-rotation[0], -rotation[1], -rotation[2]};
+    T Y[3];
+    ceres::AngleAxisRotatePoint(inverse, shifted, Y);
+    const T s = exp(log_scale[0]);
+    T Z[3];
+    for (int r = 0; r < 3; ++r) {
+      Z[r] = view.R(r, 0) * Y[0] + view.R(r, 1) * Y[1] + view.R(r, 2) * Y[2] + s * view.t(r);
+    }
+    residual[0] = view.fx * Z[0] / Z[2] + view.cx - x.x();
+    residual[1] = view.fy * Z[1] / Z[2] + view.cy - x.y();
+    return true;
+  }
+
+  const PinholeView view;
+  const Eigen::Vector3d X;
+  const Eigen::Vector2d x;
+};
+
+}  // namespace
+
+Eigen::MatrixXd Similarity3::Apply(const Eigen::MatrixXd& points) const {
+  MR_CHECK_EQ(points.cols(), 3);
+  Eigen::MatrixXd out(points.rows(), 3);
+  for (Eigen::Index k = 0; k < points.rows(); ++k) {
+    out.row(k) = (*this)(points.row(k).transpose()).transpose();
+  }
+  return out;
+}
+
+PinholeView Similarity3::Apply(const PinholeView& view) const {
+  // X_c = R_i X + t_i with X = Rᵀ (X' - t) / s, times s (the projection is
+  // unchanged): R_i Rᵀ X' + s t_i - R_i Rᵀ t.
+  PinholeView out = view;
+  out.R = view.R * rotation.transpose();
+  out.t = scale * view.t - out.R * translation;
+  return out;
+}
+
+Similarity3 AlignCamerasToTruth(const Reconstruction& model, const Reconstruction& truth,
+                                const Eigen::MatrixXd& surface_points) {
+  MR_CHECK_EQ(surface_points.cols(), 3);
+  const MatchedViews matched = MatchViews(model, truth);
+  const int n = static_cast<int>(matched.model.size());
+  Similarity3 start;
+  if (n >= 3) {
+    Eigen::Matrix3Xd from(3, n), to(3, n);
+    for (int i = 0; i < n; ++i) {
+      from.col(i) = matched.model[i].Center();
+      to.col(i) = matched.truth[i].Center();
+    }
+    const Eigen::Matrix4d T = Eigen::umeyama(from, to, true);
+    const double scale = T.block<3, 3>(0, 0).determinant();
+    if (std::isfinite(scale) && scale > 0) {
+      start.scale = std::cbrt(scale);
+      start.rotation = T.block<3, 3>(0, 0) / start.scale;
+      start.translation = T.block<3, 1>(0, 3);
+    }
+  }
+  double rotation[3], translation[3], log_scale = std::log(start.scale);
+  const Eigen::AngleAxisd start_rotation(start.rotation);
+  const Eigen::Vector3d start_vector = start_rotation.angle() * start_rotation.axis();
+  for (int r = 0; r < 3; ++r) rotation[r] = start_vector(r);
+  for (int r = 0; r < 3; ++r) translation[r] = start.translation(r);
+  ceres::Problem problem;
+  constexpr int kMaxPointsPerView = 200;
+  for (int i = 0; i < n; ++i) {
+    const VisiblePoints visible = FindVisible(matched.truth[i], surface_points);
+    const size_t stride = std::max<size_t>(1, visible.camera.size() / kMaxPointsPerView);
+    for (size_t k = 0; k < visible.camera.size(); k += stride) {
+      const PinholeView& true_view = matched.truth[i];
+      const Eigen::Vector3d X = true_view.R.transpose() * (visible.camera[k] - true_view.t);
+      problem.AddResidualBlock(
+          new ceres::AutoDiffCostFunction<AlignmentResidual, 2, 3, 3, 1>(
+              new AlignmentResidual(matched.model[i], X, visible.image[k])),
+          nullptr, rotation, translation, &log_scale);
+    }
+  }
+  if (problem.NumResidualBlocks() == 0) return start;
+  ceres::Solver::Options options;
+  options.linear_solver_type = ceres::DENSE_QR;
+  options.max_num_iterations = 50;
+  options.num_threads = 1;
+  options.logging_type = ceres::SILENT;
+  ceres::Solver::Summary summary;
+  ceres::Solve(options, &problem, &summary);
+  Similarity3 result;
+  result.scale = std::exp(log_scale);
+  const Eigen::Vector3d w(rotation[0], rotation[1], rotation[2]);
+  result.rotation = ExpRotation(w);
+  result.translation = Eigen::Vector3d(translation[0], translation[1], translation[2]);
+  return result;
+}
+
+CameraComparison CompareCameras(const Reconstruction& model, const Reconstruction& truth,
+                                const Eigen::MatrixXd& surface_points,
+                                const Similarity3* model_to_truth) {
+  const MatchedViews matched = MatchViews(model, truth);
+  CameraComparison comparison;
+  double sum_sq = 0;
+  std::set<std::pair<uint32_t, uint32_t>> cameras_seen;  // (model, true) camera ids
+  for (size_t k = 0; k < matched.model.size(); ++k) {
+    const PinholeView view =
+        model_to_truth != nullptr ? model_to_truth->Apply(matched.model[k]) : matched.model[k];
+    const PinholeView& true_view = matched.truth[k];
     const double rms = ReprojectionRms(true_view, view, surface_points);
     sum_sq += rms * rms;
     if (rms > comparison.max_rms_px || comparison.num_images == 0) {
       comparison.max_rms_px = rms;
-      comparison.max_rms_image = image.name;
+      comparison.max_rms_image = matched.names[k];
     }
     ++comparison.num_images;
-    if (!cameras_seen.emplace(image.camera_id, true_image.camera_id).second) continue;
+    if (!cameras_seen.insert(matched.camera_ids[k]).second) continue;
     for (const double ratio : {view.fx / true_view.fx, view.fy / true_view.fy}) {
       comparison.max_focal_percent =
           std::max(comparison.max_focal_percent, 100 * std::abs(ratio - 1));

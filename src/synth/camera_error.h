@@ -94,11 +94,42 @@ struct CameraComparison {
   std::string JsonMembers() const;
 };
 
+// A similarity transform of the world: X' = scale * rotation * X + translation.
+struct Similarity3 {
+  double scale = 1;
+  Eigen::Matrix3d rotation = Eigen::Matrix3d::Identity();
+  Eigen::Vector3d translation = Eigen::Vector3d::Zero();
+
+  Eigen::Vector3d operator()(const Eigen::Vector3d& X) const {
+    return scale * rotation * X + translation;
+  }
+  // Every row of `points` (#P by 3) transformed.
+  Eigen::MatrixXd Apply(const Eigen::MatrixXd& points) const;
+  // The camera carried along: it sees X' where `view` saw X.
+  PinholeView Apply(const PinholeView& view) const;
+};
+
+// The similarity that carries `model`'s world into `truth`'s so that its
+// cameras agree best with the true ones: it minimises, over the images of
+// `model` (matched by name, as CompareCameras), the squared displacement of
+// the projections of up to 200 of the `surface_points` (true world) each true
+// view sees. Started from the similarity of the camera centres (Umeyama)
+// when there are 3 or more, else from the identity; solved with Ceres.
+// An SfM model fixes its world only up to such a transform (the gauge), and
+// so does a model whose every pose carries an independent error: the mean
+// of the errors moves the whole reconstruction. Comparing after this
+// alignment judges cameras, and a mesh in their world, by what the images
+// can determine. Requirements as CompareCameras.
+Similarity3 AlignCamerasToTruth(const Reconstruction& model, const Reconstruction& truth,
+                                const Eigen::MatrixXd& surface_points);
+
 // Every image of `model` must be in `truth` under the same name, with a
 // PINHOLE or SIMPLE_PINHOLE camera in both (InputError otherwise, naming it);
 // `truth` may hold more images. An image whose true view sees none of the
-// points counts as 0 px.
+// points counts as 0 px. `model_to_truth` (optional) carries the model's
+// cameras into the true world first (AlignCamerasToTruth).
 CameraComparison CompareCameras(const Reconstruction& model, const Reconstruction& truth,
-                                const Eigen::MatrixXd& surface_points);
+                                const Eigen::MatrixXd& surface_points,
+                                const Similarity3* model_to_truth = nullptr);
 
 }  // namespace mr

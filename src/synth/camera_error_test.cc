@@ -475,5 +475,74 @@ TEST(CompareCameras, MeasuresThePerturbation) {
   }
 }
 
+// The model's world carried by a similarity T (the truth's cameras moved with
+// their world, and each also moved by its own pose error when `perturbed`).
+Reconstruction CarriedModel(const Reconstruction& truth, const Similarity3& T) {
+  Reconstruction model = truth;
+  for (auto& [id, image] : model.images) {
+    const PinholeView view = T.Apply(ViewOf(truth, id));
+    image.qvec = RotationToQuaternion(view.R);
+    image.tvec = view.t;
+  }
+  return model;
+}
+
+Similarity3 TestSimilarity() {
+  Similarity3 T;
+  T.scale = 1.7;
+  T.rotation = Eigen::AngleAxisd(0.6, Eigen::Vector3d(1, -2, 0.5).normalized()).toRotationMatrix();
+  T.translation = Eigen::Vector3d(40, -15, 8);
+  return T;
+}
+
+// Similarity3 carries a camera with its world: the carried view projects the
+// carried point where the view projected the point.
+TEST(Similarity3, CarriesCamerasWithTheirWorld) {
+  const Similarity3 T = TestSimilarity();
+  const PinholeView view = RingViews()[3];
+  const PinholeView carried = T.Apply(view);
+  const Eigen::MatrixXd P = SpherePoints(50, 30);
+  const Eigen::MatrixXd Q = T.Apply(P);
+  for (int k = 0; k < P.rows(); ++k) {
+    EXPECT_LT((carried.Project(Q.row(k).transpose()) - view.Project(P.row(k).transpose())).norm(),
+              1e-9);
+  }
+  EXPECT_NEAR((carried.Center() - T(view.Center())).norm(), 0, 1e-9);
+}
+
+// AlignCamerasToTruth undoes a similarity of the whole model (the gauge), and
+// after it the comparison measures only what differs between the views.
+TEST(AlignCamerasToTruth, RemovesTheGaugeAndOnlyIt) {
+  const Eigen::MatrixXd P = SpherePoints(4000, 30);
+  const Reconstruction truth = ModelOf(RingViews(), P);
+  const Similarity3 T = TestSimilarity();
+  const Reconstruction moved = CarriedModel(truth, T);
+  EXPECT_GT(CompareCameras(moved, truth, P).rms_px, 100);
+  const Similarity3 S = AlignCamerasToTruth(moved, truth, P);
+  EXPECT_NEAR(S.scale * T.scale, 1, 1e-9);
+  for (int k = 0; k < P.rows(); k += 97) {
+    const Eigen::Vector3d X = P.row(k).transpose();
+    EXPECT_LT((S(T(X)) - X).norm(), 1e-7);
+  }
+  EXPECT_LT(CompareCameras(moved, truth, P, &S).rms_px, 1e-7);
+
+  // Pose errors: aligning never makes the comparison worse than the
+  // identity (it minimises what the comparison measures), and carrying the
+  // perturbed model by T changes nothing once aligned.
+  CameraErrorOptions options;
+  options.pose_error_px = 1;
+  Reconstruction perturbed = truth;
+  PerturbCameras(options, P, 7, &perturbed);
+  const double raw = CompareCameras(perturbed, truth, P).rms_px;
+  const Similarity3 A = AlignCamerasToTruth(perturbed, truth, P);
+  const double aligned = CompareCameras(perturbed, truth, P, &A).rms_px;
+  std::printf("pose error: %.3f px as it is, %.3f px aligned\n", raw, aligned);
+  EXPECT_LT(aligned, raw);
+  EXPECT_GT(aligned, 0.3);  // eight independent errors: most of them is not gauge
+  const Reconstruction perturbed_moved = CarriedModel(perturbed, T);
+  const Similarity3 B = AlignCamerasToTruth(perturbed_moved, truth, P);
+  EXPECT_NEAR(CompareCameras(perturbed_moved, truth, P, &B).rms_px, aligned, 1e-6);
+}
+
 }  // namespace
 }  // namespace mr
