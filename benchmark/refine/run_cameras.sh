@@ -74,7 +74,7 @@ for name in $cases; do
       rflags=${config#*|}
       wanted "$lname" "$label" || continue
       stem="$ws.$label"
-      if [ ! -f "$stem.time" ]; then
+      if [ ! -s "$stem.time" ] || [ ! -f "$ws/dense/meshed-refined-$label.ply" ]; then
         echo "[$(date +%T)] $name ($lname): $label" >&2
         rm -rf "$ws/dense/sparse_refined"
         # shellcheck disable=SC2086
