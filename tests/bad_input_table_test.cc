@@ -297,6 +297,9 @@ std::vector<BadInput> Table() {
       {"RefinerMaxImageSizeZero", R, "`--Refine.max_image_size 0`", kNothing,
        kWs + " --Refine.max_image_size 0", 1,
        "RefineOptions::max_image_size = 0. Violated constraint: max_image_size >= 32 or -1"},
+      {"RefinerCameraRoundsZero", R, "`--Refine.camera_rounds 0`", kNothing,
+       kWs + " --Refine.camera_rounds 0", 1,
+       "RefineOptions::camera_rounds = 0. Violated constraint: camera_rounds >= 1"},
       {"RefinerRefineCamerasUnknown", R, "`--Refine.refine_cameras all`", kNothing,
        kWs + " --Refine.refine_cameras all", 1,
        "RefineOptions::refine_cameras = all. Violated constraint: one of none, poses, "

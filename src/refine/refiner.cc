@@ -127,6 +127,15 @@ void RefineCamerasAtLevel(const RefineOptions& options,
   }
 }
 
+// Whether the finest level refines the cameras before iteration `it` of
+// `iterations`: `rounds` times, evenly spaced (1: halfway).
+bool IsCameraRound(int it, int iterations, int rounds) {
+  for (int k = 1; k <= rounds; ++k) {
+    if (it == k * iterations / (rounds + 1)) return true;
+  }
+  return false;
+}
+
 // Remeshes to the level's target edge length, within the face budget.
 void RemeshForLevel(const std::vector<PinholeView>& views, const RefineOptions& options,
                     int max_faces, Eigen::MatrixXd* V, Eigen::MatrixXi* F) {
@@ -479,6 +488,7 @@ bool RefineOptions::Check() const {
   if (refine_cameras != "none" && refine_cameras != "poses" && refine_cameras != "poses_intrinsics") {
     fail("refine_cameras", refine_cameras, "one of none, poses, poses_intrinsics");
   }
+  if (camera_rounds < 1) fail("camera_rounds", std::to_string(camera_rounds), "camera_rounds >= 1");
   if (refine_cameras != "none") {
     CameraRefinementOptions cameras = camera_refinement;
     cameras.mode = refine_cameras;
@@ -727,11 +737,11 @@ RefineSummary RefineMesh(const ViewSource& input_source, const RefineOptions& op
                          : 0.0;
       similarity.kappa = record.kappa;
 
-      // The finest level refines the cameras once more halfway, against the
-      // surface its first iterations made (the level's start mesh was fitted
-      // to the old cameras).
+      // The finest level refines the cameras once more halfway (or
+      // camera_rounds times, evenly spaced), against the surface its first
+      // iterations made (the level's start mesh was fitted to the old cameras).
       if (options.refine_cameras != "none" && level == 0 && it > 0 &&
-          it == options.iterations_per_level / 2) {
+          IsCameraRound(it, options.iterations_per_level, options.camera_rounds)) {
         RefineCamerasAtLevel(options, pairs, V, F, level, camera_of_view, renderer,
                              cache_bytes / 2, full_views, &images, &views, &cameras, &summary);
         level_similarities.clear();  // measured through other cameras
@@ -1030,6 +1040,9 @@ void RegisterRefineOptions(OptionManager* o, RefineOptions* r) {
   o->Add("Refine.refine_cameras", &r->refine_cameras,
          "photometric camera refinement at the start of every level but the first and halfway "
          "through the finest: none, poses, poses_intrinsics");
+  o->Add("Refine.camera_rounds", &r->camera_rounds,
+         "with refine_cameras: refinements within the finest level, evenly spaced (>= 1; 1: "
+         "halfway)");
   o->Add("CameraRefinement.max_samples_per_pair", &r->camera_refinement.max_samples_per_pair,
          "pixels sampled per ordered view pair (>= 1)");
   o->Add("CameraRefinement.intensity_sigma", &r->camera_refinement.intensity_sigma,
