@@ -50,7 +50,9 @@ def main(path):
                             ("normal", nratio), ("aligned_normal", anratio),
                             ("cameras", m["camera_rms_px"]),
                             ("aligned_cameras", a["camera_rms_px"])):
-            w[name] = max(w[name], value)
+            # A ratio without the case's exact-camera run (LEVELS without
+            # "exact") is nan and makes the worst case nan too.
+            w[name] = value if value != value else max(w[name], value)
         if config not in ("input", "none") and (case, level) in none_time:
             w["time_ratio"] = max(w["time_ratio"], secs / none_time[(case, level)])
     print()
