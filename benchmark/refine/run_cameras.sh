@@ -55,15 +55,13 @@ for name in $cases; do
     truth="$ws/sparse_true"
     [ -d "$truth" ] || truth="$ws/dense/sparse"
     evaluate() {  # mesh cameras stem: STEM.json as it is, STEM.aligned.json datum-aligned
-      if [ ! -f "$3.json" ]; then
-        "$BIN/mesh_evaluator" --input_path "$1" --gt_path "$ws/ground_truth.ply" \
-          --workspace_path "$ws/dense" --sparse_path "$2" --true_sparse_path "$truth" > "$3.json"
-      fi
-      if [ ! -f "$3.aligned.json" ]; then
+      for variant in "json 0" "aligned.json 1"; do
+        set -- "$1" "$2" "$3" $variant
+        [ -f "$3.$4" ] && continue
         "$BIN/mesh_evaluator" --input_path "$1" --gt_path "$ws/ground_truth.ply" \
           --workspace_path "$ws/dense" --sparse_path "$2" --true_sparse_path "$truth" \
-          --align_cameras 1 > "$3.aligned.json"
-      fi
+          --align_cameras "$5" > "$3.$4"
+      done
     }
     evaluate "$ws/dense/meshed-poisson.ply" "$ws/dense/sparse" "$ws.input"
     printf '%s\t%s\tinput\t%s\t%s\t0\t0\n' "$name" "$lname" "$(cat "$ws.input.json")" \

@@ -155,9 +155,10 @@ struct RefineOptions {
   std::string refine_cameras = "none";
   // How often refine_cameras refines them within the finest level, at evenly
   // spaced iterations (>= 1; 1: halfway). Measured after the datum alignment
-  // at 1 px of pose error (docs/camera_refinement.md): 2 brings the textured
-  // corpus cases from 1.14-1.26x to 1.07-1.14x the exact-camera run, at the
-  // price of a second refinement; the shading-only case gains little.
+  // at 1 px of pose error (docs/camera_refinement.md): 2 brings
+  // builtin-contrast and rocker-head-noise from 1.135x and 1.263x to 1.069x
+  // and 1.140x the exact-camera run, at the price of a second refinement;
+  // the shading-only fandisk-shading gains little (1.275x -> 1.253x).
   int camera_rounds = 1;
   CameraRefinementOptions camera_refinement;  // its mode follows refine_cameras
   // lp proximal step: estimate the noise to remove from what the gradient

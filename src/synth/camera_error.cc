@@ -348,10 +348,10 @@ Similarity3 AlignCamerasToTruth(const Reconstruction& model, const Reconstructio
   ceres::Problem problem;
   constexpr int kMaxPointsPerView = 200;
   for (int i = 0; i < n; ++i) {
-    const VisiblePoints visible = FindVisible(matched.truth[i], surface_points);
+    const PinholeView& true_view = matched.truth[i];
+    const VisiblePoints visible = FindVisible(true_view, surface_points);
     const size_t stride = std::max<size_t>(1, visible.camera.size() / kMaxPointsPerView);
     for (size_t k = 0; k < visible.camera.size(); k += stride) {
-      const PinholeView& true_view = matched.truth[i];
       const Eigen::Vector3d X = true_view.R.transpose() * (visible.camera[k] - true_view.t);
       problem.AddResidualBlock(
           new ceres::AutoDiffCostFunction<AlignmentResidual, 2, 3, 3, 1>(
