@@ -300,6 +300,9 @@ std::vector<BadInput> Table() {
       {"RefinerCameraRoundsZero", R, "`--Refine.camera_rounds 0`", kNothing,
        kWs + " --Refine.camera_rounds 0", 1,
        "RefineOptions::camera_rounds = 0. Violated constraint: camera_rounds >= 1"},
+      {"RefinerMaskOutlineOffsetNegative", R, "`--MaskOutline.min_offset_px -1`", kNothing,
+       kWs + " --MaskOutline.min_offset_px -1", 1,
+       "MaskOutlineOptions::min_offset_px = -1. Violated constraint: min_offset_px >= 0"},
       {"RefinerRefineCamerasUnknown", R, "`--Refine.refine_cameras all`", kNothing,
        kWs + " --Refine.refine_cameras all", 1,
        "RefineOptions::refine_cameras = all. Violated constraint: one of none, poses, "

@@ -153,6 +153,10 @@ void PrintSummary(const Workspace& workspace, const ViewSource& source, const Tr
               "--Refine.max_image_size %d)\n",
               working.View(largest).width, working.View(largest).height, resized,
               working.NumViews(), refine.max_image_size);
+  if (working.HasMasks()) {
+    std::printf("Masks: %s%s\n", MeasureMaskOutline(working, refine.mask_outline).BriefReport().c_str(),
+                refine.align_masks ? "" : " (--Refine.align_masks 0: used as given)");
+  }
   const int max_faces = refine.FaceBudget(mesh.NumFaces());
   std::printf("Faces at the finest level: about %d (%.2g px edges, at most %d)\n",
               RemeshedFaceCount(working.Views(), mesh.V, mesh.F, refine.target_edge_px, max_faces),

@@ -501,6 +501,7 @@ bool RefineOptions::Check() const {
   if (!(silhouette_weight >= 0)) fail("silhouette_weight", std::to_string(silhouette_weight), "silhouette_weight >= 0");
   if (cache_mb < 64) fail("cache_mb", std::to_string(cache_mb), "cache_mb >= 64");
   background_mask.Check();
+  mask_outline.Check();
   view_selection.Check();
   similarity_options.Check();
   pair.Check();
@@ -520,6 +521,7 @@ std::string RefineSummary::FullReport() const {
   std::ostringstream out;
   out << BriefReport() << "\n";
   if (!schedule.empty()) out << "  schedule: " << schedule << "\n";
+  if (!masks.empty()) out << "  masks: " << masks << "\n";
   out << "  views " << num_views << ", pairs " << num_pairs << ", vertices " << initial_vertices
       << " -> " << final_vertices << ", flipped faces fixed " << flipped_faces_fixed
       << ", steps taken back " << steps_taken_back << ", levels ended on their best iterate "
@@ -576,17 +578,26 @@ RefineSummary RefineMesh(const ViewSource& input_source, const RefineOptions& op
   const ResizedViewSource working(input_source, options.max_image_size);
   // Without masks, masks from a uniform background where they agree with the
   // input mesh, for the silhouette term (made at the working resolution).
-  std::unique_ptr<BackgroundMaskedViewSource> background_masked;
+  std::unique_ptr<ViewSource> masked;
   if (!working.HasMasks() && options.masks_from_background && options.silhouette_weight > 0) {
     BackgroundMaskReport report;
-    background_masked = MakeBackgroundMasks(working, mesh->V, mesh->F, renderer,
-                                            options.background_mask, &report);
+    masked = MakeBackgroundMasks(working, mesh->V, mesh->F, renderer, options.background_mask,
+                                 &report);
     MR_LOG(INFO) << "No masks given: " << report.BriefReport();
   }
-  const ViewSource& source =
-      background_masked ? static_cast<const ViewSource&>(*background_masked) : working;
+  // Given masks whose outline lies off the images' edges are moved onto them.
+  MaskOutlineReport mask_report;
+  if (working.HasMasks() && options.align_masks && options.silhouette_weight > 0) {
+    mask_report = MeasureMaskOutline(working, options.mask_outline);
+    MR_LOG(INFO) << "Masks: " << mask_report.BriefReport();
+    if (mask_report.move) {
+      masked = std::make_unique<MovedMaskViewSource>(working, mask_report.edge_offset_px);
+    }
+  }
+  const ViewSource& source = masked ? static_cast<const ViewSource&>(*masked) : working;
 
   RefineSummary summary;
+  summary.masks = mask_report.views_measured > 0 ? mask_report.BriefReport() : "";
   summary.num_views = source.NumViews();
   summary.initial_faces = mesh->NumFaces();
   summary.initial_vertices = mesh->NumVertices();
@@ -1069,6 +1080,12 @@ void RegisterRefineOptions(OptionManager* o, RefineOptions* r) {
   o->Add("Refine.masks_from_background", &r->masks_from_background,
          "without masks, make them from a uniform background where they agree with the input "
          "mesh (for the silhouette term)");
+  o->Add("Refine.align_masks", &r->align_masks,
+         "with given masks, move their outlines onto the images' edges when these lie clearly "
+         "off them (masks grown for a visual hull)");
+  o->Add("MaskOutline.min_offset_px", &r->mask_outline.min_offset_px,
+         "the masks are moved when the images' edges lie at least this far from their outlines "
+         "(pixels)");
   o->Add("BackgroundMask.min_agreement", &r->background_mask.min_agreement,
          "a view's background mask is used when its intersection over union with the input "
          "mesh's rendered coverage is at least this");

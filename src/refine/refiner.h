@@ -11,6 +11,7 @@
 #include "colmap_io/ply.h"
 #include "refine/background_mask.h"
 #include "refine/camera_refinement.h"
+#include "refine/mask_outline.h"
 #include "denoise/denoiser.h"
 #include "refine/photometric.h"
 #include "refine/similarity.h"
@@ -178,6 +179,13 @@ struct RefineOptions {
   // input (accuracy90 / normal error) to 0.801x / 0.981x.
   bool masks_from_background = true;
   BackgroundMaskOptions background_mask;
+  // With given masks: measure where the images' edges lie across the masks'
+  // outlines and, when they lie clearly off (masks grown for a visual hull,
+  // loose or tight segmentations), move the masks onto them for the
+  // silhouette term (mask_outline.h). The corpus's exact masks measure
+  // within half a pixel and are used as given (docs/results.md).
+  bool align_masks = true;
+  MaskOutlineOptions mask_outline;
   // Check every iteration for faces that the step made intersect and move
   // their vertices back (UndoSelfIntersections), so that thin parts cannot
   // fold through each other. Off: only the final repair runs.
@@ -241,6 +249,7 @@ constexpr double kGuardOverrideFraction = 0.10;
 struct RefineSummary {
   std::string termination;  // "FINISHED" or why it stopped
   std::string schedule;     // num_levels 0: what was chosen and why
+  std::string masks;        // given masks: where their outlines lie (align_masks)
   int num_views = 0;
   int num_pairs = 0;
   int initial_faces = 0, final_faces = 0;
