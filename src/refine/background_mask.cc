@@ -199,7 +199,7 @@ double MaskAgreement(const cv::Mat& a, const cv::Mat& b) {
 
 BackgroundMaskedViewSource::BackgroundMaskedViewSource(const ViewSource& base,
                                                        std::vector<std::vector<uchar>> masks)
-    : base_(base), masks_(std::move(masks)) {
+    : DerivedViewSource(base), masks_(std::move(masks)) {
   MR_CHECK(static_cast<int>(masks_.size()) == base_.NumViews());
   for (const auto& m : masks_) num_masked_ += m.empty() ? 0 : 1;
 }

@@ -109,22 +109,15 @@ double MaskAgreement(const cv::Mat& a, const cv::Mat& b);
 // `base` with masks made from the uniform background of the views
 // MakeBackgroundMasks accepted; the other views have none. Every other query
 // is `base`'s. `base` must outlive this.
-class BackgroundMaskedViewSource : public ViewSource {
+class BackgroundMaskedViewSource : public DerivedViewSource {
  public:
   // `masks`: one PNG-encoded mask per view, or an empty vector for none.
   BackgroundMaskedViewSource(const ViewSource& base, std::vector<std::vector<uchar>> masks);
-  int NumViews() const override { return base_.NumViews(); }
-  const PinholeView& View(int i) const override { return base_.View(i); }
-  std::string Name(int i) const override { return base_.Name(i); }
-  cv::Mat LoadGray(int i) const override { return base_.LoadGray(i); }
-  cv::Mat LoadColor(int i) const override { return base_.LoadColor(i); }
   cv::Mat LoadMask(int i) const override;
   bool HasMasks() const override { return num_masked_ > 0; }
-  int CameraId(int i) const override { return base_.CameraId(i); }
   int NumMasked() const { return num_masked_; }
 
  private:
-  const ViewSource& base_;
   std::vector<std::vector<uchar>> masks_;  // PNG, kept small in memory
   int num_masked_ = 0;
 };

@@ -73,21 +73,13 @@ cv::Mat MoveMaskOutline(const cv::Mat& mask, double offset_px);
 
 // `base` with every mask's outline moved inwards by `offset_px`
 // (MoveMaskOutline). `base` must outlive this.
-class MovedMaskViewSource : public ViewSource {
+class MovedMaskViewSource : public DerivedViewSource {
  public:
   MovedMaskViewSource(const ViewSource& base, double offset_px)
-      : base_(base), offset_px_(offset_px) {}
-  int NumViews() const override { return base_.NumViews(); }
-  const PinholeView& View(int i) const override { return base_.View(i); }
-  std::string Name(int i) const override { return base_.Name(i); }
-  cv::Mat LoadGray(int i) const override { return base_.LoadGray(i); }
-  cv::Mat LoadColor(int i) const override { return base_.LoadColor(i); }
+      : DerivedViewSource(base), offset_px_(offset_px) {}
   cv::Mat LoadMask(int i) const override;
-  bool HasMasks() const override { return base_.HasMasks(); }
-  int CameraId(int i) const override { return base_.CameraId(i); }
 
  private:
-  const ViewSource& base_;
   double offset_px_;
 };
 

@@ -171,7 +171,8 @@ cv::Mat ImageCache::Get(int kind, int i, int level) {
   return entries_.front().second;
 }
 
-ResizedViewSource::ResizedViewSource(const ViewSource& base, int max_image_size) : base_(base) {
+ResizedViewSource::ResizedViewSource(const ViewSource& base, int max_image_size)
+    : DerivedViewSource(base) {
   for (int i = 0; i < base.NumViews(); ++i) {
     PinholeView view = base.View(i);
     const int longest = std::max(view.width, view.height);

@@ -72,29 +72,42 @@ class WorkspaceViewSource : public ViewSource {
   std::vector<PinholeView> views_;
 };
 
+// A view source made from another: every query goes to `base` unless the
+// derived source overrides it. `base` must outlive this.
+class DerivedViewSource : public ViewSource {
+ public:
+  explicit DerivedViewSource(const ViewSource& base) : base_(base) {}
+  int NumViews() const override { return base_.NumViews(); }
+  const PinholeView& View(int i) const override { return base_.View(i); }
+  std::string Name(int i) const override { return base_.Name(i); }
+  cv::Mat LoadGray(int i) const override { return base_.LoadGray(i); }
+  cv::Mat LoadColor(int i) const override { return base_.LoadColor(i); }
+  cv::Mat LoadMask(int i) const override { return base_.LoadMask(i); }
+  bool HasMasks() const override { return base_.HasMasks(); }
+  int CameraId(int i) const override { return base_.CameraId(i); }
+
+ protected:
+  const ViewSource& base_;
+};
+
 // `base` with every image whose longest side exceeds `max_image_size` pixels
 // scaled down to that size (cv::INTER_AREA), and its camera with it, as
 // COLMAP's max_image_size options do: the sizes round to whole pixels, and
 // fx, cx scale by the width's ratio, fy, cy by the height's. Masks are
 // scaled the same way and thresholded at half. Smaller images pass through
 // unchanged; max_image_size <= 0 means no limit. `base` must outlive this.
-class ResizedViewSource : public ViewSource {
+class ResizedViewSource : public DerivedViewSource {
  public:
   ResizedViewSource(const ViewSource& base, int max_image_size);
-  int NumViews() const override { return base_.NumViews(); }
   const PinholeView& View(int i) const override { return views_.at(i); }
-  std::string Name(int i) const override { return base_.Name(i); }
   cv::Mat LoadGray(int i) const override;
   cv::Mat LoadColor(int i) const override;
   cv::Mat LoadMask(int i) const override;
-  bool HasMasks() const override { return base_.HasMasks(); }
-  int CameraId(int i) const override { return base_.CameraId(i); }
   // Whether view i is scaled down.
   bool Resized(int i) const;
 
  private:
   cv::Mat Resize(int i, const cv::Mat& image) const;
-  const ViewSource& base_;
   std::vector<PinholeView> views_;
 };
 
