@@ -1,6 +1,7 @@
 #include "geometry/mesh.h"
 
 #include <algorithm>
+#include <cstdint>
 #include <unordered_map>
 
 #include <Eigen/Geometry>
@@ -125,6 +126,45 @@ std::vector<int> RemoveUnreferencedVertices(Eigen::MatrixXd* V, Eigen::MatrixXi*
   }
   *V = std::move(W);
   return map;
+}
+
+namespace {
+
+// The bits of a 21-bit integer spread to every third bit.
+uint64_t SpreadBits(uint64_t x) {
+  x &= 0x1fffff;
+  x = (x | x << 32) & 0x1f00000000ffffULL;
+  x = (x | x << 16) & 0x1f0000ff0000ffULL;
+  x = (x | x << 8) & 0x100f00f00f00f00fULL;
+  x = (x | x << 4) & 0x10c30c30c30c30c3ULL;
+  x = (x | x << 2) & 0x1249249249249249ULL;
+  return x;
+}
+
+}  // namespace
+
+std::vector<int> OrderSpatially(Eigen::MatrixXd* V, Eigen::MatrixXi* F) {
+  const int num_faces = static_cast<int>(F->rows());
+  if (num_faces == 0) return RemoveUnreferencedVertices(V, F);
+  const Eigen::RowVector3d lo = V->colwise().minCoeff(), hi = V->colwise().maxCoeff();
+  const double extent = std::max((hi - lo).maxCoeff(), 1e-300);
+  const double cells = (1 << 21) - 1;
+  std::vector<std::pair<uint64_t, int>> keyed(num_faces);
+  for (int f = 0; f < num_faces; ++f) {
+    const Eigen::RowVector3d c =
+        (V->row((*F)(f, 0)) + V->row((*F)(f, 1)) + V->row((*F)(f, 2))) / 3.0;
+    uint64_t code = 0;
+    for (int a = 0; a < 3; ++a) {
+      const double t = std::clamp((c(a) - lo(a)) / extent, 0.0, 1.0);
+      code |= SpreadBits(static_cast<uint64_t>(t * cells)) << a;
+    }
+    keyed[f] = {code, f};
+  }
+  std::sort(keyed.begin(), keyed.end());
+  Eigen::MatrixXi sorted(num_faces, 3);
+  for (int f = 0; f < num_faces; ++f) sorted.row(f) = F->row(keyed[f].second);
+  *F = std::move(sorted);
+  return RemoveUnreferencedVertices(V, F);
 }
 
 }  // namespace mr

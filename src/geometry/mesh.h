@@ -41,4 +41,11 @@ std::vector<std::vector<int>> VertexAdjacency(const Eigen::MatrixXi& F, int num_
 // for each old vertex its new index or -1.
 std::vector<int> RemoveUnreferencedVertices(Eigen::MatrixXd* V, Eigen::MatrixXi* F);
 
+// Reorders faces and vertices along a space-filling curve (Morton order of
+// the face centroids; vertices numbered by first use), so that faces and
+// vertices near each other in space are near each other in memory. The
+// surface is unchanged: the same triangles, each with its corners in the same
+// cyclic order. Returns for each old vertex its new index.
+std::vector<int> OrderSpatially(Eigen::MatrixXd* V, Eigen::MatrixXi* F);
+
 }  // namespace mr

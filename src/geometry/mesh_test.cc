@@ -1,5 +1,12 @@
 #include <gtest/gtest.h>
 
+#include <algorithm>
+#include <array>
+#include <cstdio>
+#include <numeric>
+#include <random>
+#include <vector>
+
 #include <Eigen/LU>
 
 #include "geometry/mesh.h"
@@ -110,6 +117,78 @@ TEST(Primitives, IcosphereIsClosedAndOutward) {
     EXPECT_GT(N.row(f).dot(c), 0) << "face " << f << " points inward";
   }
   EXPECT_NEAR(V.rowwise().norm().maxCoeff(), 2.0, 1e-12);
+}
+
+// Each triangle as its three corner positions, rotated to start at the
+// smallest, so that the same triangle with the same winding compares equal.
+std::vector<std::array<double, 9>> Triangles(const Eigen::MatrixXd& V, const Eigen::MatrixXi& F) {
+  std::vector<std::array<double, 9>> out;
+  for (int f = 0; f < F.rows(); ++f) {
+    std::array<std::array<double, 3>, 3> corners;
+    for (int k = 0; k < 3; ++k) corners[k] = {V(F(f, k), 0), V(F(f, k), 1), V(F(f, k), 2)};
+    const int first = static_cast<int>(std::min_element(corners.begin(), corners.end()) - corners.begin());
+    std::array<double, 9> t;
+    for (int k = 0; k < 3; ++k) {
+      for (int a = 0; a < 3; ++a) t[3 * k + a] = corners[(first + k) % 3][a];
+    }
+    out.push_back(t);
+  }
+  std::sort(out.begin(), out.end());
+  return out;
+}
+
+// Mean distance in memory (index difference) between the vertices of each
+// edge: what the spatial order makes small.
+double MeanIndexSpread(const Eigen::MatrixXi& F) {
+  double sum = 0;
+  for (int f = 0; f < F.rows(); ++f) {
+    for (int k = 0; k < 3; ++k) sum += std::abs(F(f, k) - F(f, (k + 1) % 3));
+  }
+  return sum / (3.0 * F.rows());
+}
+
+TEST(Mesh, OrderSpatiallyKeepsTheSurfaceAndGathersNeighbours) {
+  Eigen::MatrixXd V;
+  Eigen::MatrixXi F;
+  MakeIcosphere(5, 1.0, &V, &F);
+  // Shuffled, as a remesher's output can be.
+  std::mt19937 rng(3);
+  std::vector<int> perm(V.rows());
+  std::iota(perm.begin(), perm.end(), 0);
+  std::shuffle(perm.begin(), perm.end(), rng);
+  Eigen::MatrixXd shuffled(V.rows(), 3);
+  for (int v = 0; v < V.rows(); ++v) shuffled.row(perm[v]) = V.row(v);
+  for (int f = 0; f < F.rows(); ++f) {
+    for (int k = 0; k < 3; ++k) F(f, k) = perm[F(f, k)];
+  }
+  std::vector<int> rows(F.rows());
+  std::iota(rows.begin(), rows.end(), 0);
+  std::shuffle(rows.begin(), rows.end(), rng);
+  Eigen::MatrixXi shuffled_F(F.rows(), 3);
+  for (int f = 0; f < F.rows(); ++f) shuffled_F.row(f) = F.row(rows[f]);
+  // And a vertex no face uses.
+  shuffled.conservativeResize(shuffled.rows() + 1, 3);
+  shuffled.row(shuffled.rows() - 1) << 5, 5, 5;
+
+  Eigen::MatrixXd W = shuffled;
+  Eigen::MatrixXi G = shuffled_F;
+  const std::vector<int> map = OrderSpatially(&W, &G);
+  ASSERT_EQ(G.rows(), shuffled_F.rows());
+  ASSERT_EQ(W.rows(), shuffled.rows() - 1);  // the unused vertex is gone
+  EXPECT_EQ(map.back(), -1);
+  for (int v = 0; v + 1 < shuffled.rows(); ++v) {
+    ASSERT_GE(map[v], 0);
+    EXPECT_EQ(W.row(map[v]), shuffled.row(v));
+  }
+  EXPECT_EQ(Triangles(W, G), Triangles(shuffled, shuffled_F));
+  const double before = MeanIndexSpread(shuffled_F), after = MeanIndexSpread(G);
+  std::printf("mean index spread of an edge: %.0f shuffled, %.0f ordered (%d vertices)\n", before,
+              after, static_cast<int>(W.rows()));
+  EXPECT_LT(after, 0.05 * before);
+  // An empty mesh stays empty.
+  Eigen::MatrixXd E(0, 3);
+  Eigen::MatrixXi EF(0, 3);
+  EXPECT_TRUE(OrderSpatially(&E, &EF).empty());
 }
 
 }  // namespace

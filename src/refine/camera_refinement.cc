@@ -7,6 +7,7 @@
 #include <map>
 #include <memory>
 #include <sstream>
+#include <thread>
 #include <unordered_map>
 
 #include <Eigen/Geometry>
@@ -800,7 +801,10 @@ CameraRefinementSummary RefineCameras(const std::vector<cv::Mat>& gray_images,
   solver.linear_solver_ordering = ordering;
   solver.max_num_iterations = options.max_iterations;
   solver.function_tolerance = options.function_tolerance;
-  solver.num_threads = 1;
+  // Residuals, Jacobians and the Schur elimination on every core (the
+  // example's refinement 6.4 -> 5.3-5.9 s on 2 cores, the same cost to 4
+  // digits).
+  solver.num_threads = std::max(1, static_cast<int>(std::thread::hardware_concurrency()));
   solver.logging_type = ceres::SILENT;
   ceres::Solver::Summary ceres_summary;
   ceres::Solve(solver, &problem, &ceres_summary);
