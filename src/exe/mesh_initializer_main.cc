@@ -2,6 +2,7 @@
 // outward-oriented PLY mesh (an initial surface where COLMAP gives none).
 
 #include <algorithm>
+#include <cmath>
 #include <exception>
 #include <iostream>
 #include <set>
@@ -11,9 +12,11 @@
 #include "colmap_io/ply.h"
 #include "colmap_io/workspace.h"
 #include "geometry/view.h"
-#include "init/middlebury.h"
 #include "init/isosurface.h"
+#include "init/middlebury.h"
 #include "init/visual_hull.h"
+#include "refine/mask_outline.h"
+#include "refine/view_source.h"
 #ifdef MR_HAVE_REMESH
 #include "geometry/remesh.h"
 #endif
@@ -120,6 +123,20 @@ int main(int argc, char** argv) {
     for (const auto& n : skipped) skipped_list += " " + n;
     MR_LOG(INFO) << "Carving with " << views.size() << " masks; skipped " << skipped.size()
                  << (skipped.empty() ? "" : ":" + skipped_list);
+    // A mask that leaves out part of the object carves that part away: the
+    // hull needs masks that cover the object, and is only conservative with
+    // larger ones (mask_outline.h measures where the images' edges lie).
+    const mr::MaskOutlineReport outline = mr::MeasureMaskOutline(
+        mr::WorkspaceViewSource(ws, {skipped.begin(), skipped.end()}), mr::MaskOutlineOptions());
+    if (outline.move && outline.edge_offset_px < 0) {
+      MR_LOG(WARNING) << "WARNING: the masks are tighter than the objects in the images: "
+                      << outline.Measured() << ". The visual hull cuts the object by about as "
+                      << "much; grow the masks (dilate them by "
+                      << static_cast<int>(std::ceil(-outline.edge_offset_px)) + 1
+                      << " px) for a hull that contains it";
+    } else {
+      MR_LOG(INFO) << "Masks against the images' edges: " << outline.Measured();
+    }
 
     Eigen::AlignedBox3d bbox;
     const std::string bbox_file = mr::JoinPaths(ws.root, "bbox.txt");

@@ -120,5 +120,30 @@ TEST(MiddleburyPipeline, SphereHullInMillimetres) {
   EXPECT_NE(ReadFileToString(log).find("ERROR"), std::string::npos);
 }
 
+// Masks that leave out part of the object make a hull that cuts it:
+// mesh_initializer warns, and says nothing for exact masks.
+TEST(MiddleburyPipeline, TightMasksAreReported) {
+  const std::string in = MakeTestDir("pipeline_tight_in");
+  WriteSphereDataSet(in);
+  const std::string exe = JoinPaths(MR_BIN_DIR, "mesh_initializer");
+  for (const int erode : {0, 3}) {
+    const std::string ws = MakeTestDir("pipeline_tight_ws" + std::to_string(erode));
+    MiddleburyConversionOptions convert;
+    convert.holdout_every = 0;
+    convert.silhouette.dilate_px = 0;
+    convert.silhouette.erode_px = erode;  // 3: every mask 3 px inside the sphere's outline
+    ConvertMiddlebury(in, ws, convert);
+    const std::string log = JoinPaths(ws, "log.txt");
+    const std::string cmd = exe + " --workspace_path " + ws + " --output_path " +
+                            JoinPaths(ws, "hull.ply") +
+                            " --resolution 30 --VisualHull.min_views 2 2> " + log;
+    ASSERT_EQ(std::system(cmd.c_str()), 0) << ReadFileToString(log);
+    const std::string text = ReadFileToString(log);
+    const bool warned = text.find("masks are tighter than the objects") != std::string::npos;
+    EXPECT_EQ(warned, erode > 0) << text;
+    EXPECT_NE(text.find("the image edge lies"), std::string::npos) << text;
+  }
+}
+
 }  // namespace
 }  // namespace mr

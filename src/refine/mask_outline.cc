@@ -32,16 +32,25 @@ bool MaskOutlineOptions::Check() const {
   return true;
 }
 
-std::string MaskOutlineReport::BriefReport() const {
+std::string MaskOutlineReport::Measured() const {
   std::ostringstream s;
   if (views_measured == 0) return "no view has a mask";
   if (peak_ratio == 0) return "no image edge near the masks' outlines";
   s.precision(3);
   s << "the image edge lies " << std::abs(edge_offset_px) << " px "
     << (edge_offset_px >= 0 ? "inside" : "outside") << " the masks' outline (" << views_measured
-    << " views; edge " << peak_ratio << "x the gradient on the outline); "
-    << (move ? "the masks are moved onto it" : "the masks are used as given");
+    << " views; ";
+  if (std::isfinite(peak_ratio)) {
+    s << "edge " << peak_ratio << "x the gradient on the outline)";
+  } else {
+    s << "no image gradient on the outline)";
+  }
   return s.str();
+}
+
+std::string MaskOutlineReport::BriefReport() const {
+  if (views_measured == 0 || peak_ratio == 0) return Measured();
+  return Measured() + (move ? "; the masks are moved onto it" : "; the masks are used as given");
 }
 
 MaskOutlineReport MeasureMaskOutline(const ViewSource& source, const MaskOutlineOptions& options) {

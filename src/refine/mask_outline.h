@@ -59,6 +59,9 @@ struct MaskOutlineReport {
   // Whether the masks are to be moved by edge_offset_px.
   bool move = false;
 
+  // Where the edge lies (for any use of the masks), and BriefReport with
+  // what the refiner does about it.
+  std::string Measured() const;
   std::string BriefReport() const;
 };
 
