@@ -12,6 +12,7 @@
 #include "eval/evaluator.h"
 #include "geometry/mesh.h"
 #include "geometry/primitives.h"
+#include "refine/background_mask.h"
 #include "refine/photometric.h"
 #include "refine/refiner.h"
 #include "refine/silhouette.h"
@@ -478,20 +479,13 @@ TEST_F(RefinerTest, SilhouetteTermFollowsTheGapBetweenOutlines) {
   const RenderBuffers render = renderer_->Render(view);
   renderer_->SetMesh(big_V, F);
   const RenderBuffers big_render = renderer_->Render(view);
-  auto coverage = [&](const RenderBuffers& r) {
-    cv::Mat mask(view.height, view.width, CV_8U);
-    for (int row = 0; row < view.height; ++row) {
-      for (int col = 0; col < view.width; ++col) mask.at<uint8_t>(row, col) = r.FaceAt(row, col) >= 0 ? 255 : 0;
-    }
-    return mask;
-  };
   const Eigen::MatrixXd N = VertexNormals(V, F);
   const double footprint = 5.0 / view.fx;
   for (const bool larger : {false, true}) {
     Eigen::MatrixXd d = Eigen::MatrixXd::Zero(V.rows(), 3);
     Eigen::VectorXd count = Eigen::VectorXd::Zero(V.rows());
     AccumulateSilhouetteTerm(V, F, N, view, render,
-                             coverage(larger ? big_render : render), 3.0, &d, &count);
+                             RenderedCoverage(larger ? big_render : render), 3.0, &d, &count);
     double radial_sum = 0;
     int contour = 0;
     for (int v = 0; v < V.rows(); ++v) {
@@ -527,11 +521,7 @@ TEST_F(RefinerTest, GrownMasksAreMovedOntoTheImageEdges) {
   InMemoryViewSource exact, grown;
   for (int i = 0; i < images.NumViews(); ++i) {
     const PinholeView& view = images.View(i);
-    const RenderBuffers render = renderer_->Render(view);
-    cv::Mat mask(view.height, view.width, CV_8U);
-    for (int r = 0; r < view.height; ++r) {
-      for (int c = 0; c < view.width; ++c) mask.at<uint8_t>(r, c) = render.FaceAt(r, c) >= 0 ? 255 : 0;
-    }
+    const cv::Mat mask = RenderedCoverage(renderer_->Render(view));
     cv::Mat larger;
     cv::dilate(mask, larger, disc);
     exact.Add(images.Name(i), view, images.LoadGray(i), mask);
