@@ -127,15 +127,6 @@ void RefineCamerasAtLevel(const RefineOptions& options,
   }
 }
 
-// Whether the finest level refines the cameras before iteration `it` of
-// `iterations`: `rounds` times, evenly spaced (1: halfway).
-bool IsCameraRound(int it, int iterations, int rounds) {
-  for (int k = 1; k <= rounds; ++k) {
-    if (it == k * iterations / (rounds + 1)) return true;
-  }
-  return false;
-}
-
 // Remeshes to the level's target edge length, within the face budget.
 void RemeshForLevel(const std::vector<PinholeView>& views, const RefineOptions& options,
                     int max_faces, Eigen::MatrixXd* V, Eigen::MatrixXi* F) {
@@ -195,6 +186,13 @@ double MedianPositive(const Eigen::VectorXd& x) {
 }
 
 }  // namespace
+
+bool IsCameraRound(int it, int iterations, int rounds) {
+  for (int k = 1; k <= rounds; ++k) {
+    if (it == k * iterations / (rounds + 1)) return true;
+  }
+  return false;
+}
 
 int BestIterateToKeep(const std::vector<double>& similarities, double giveback) {
   if (similarities.size() < 2) return -1;

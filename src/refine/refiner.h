@@ -223,6 +223,10 @@ struct RefineIteration {
   double seconds = 0;
 };
 
+// Whether the finest level refines the cameras before iteration `it` of
+// `iterations` (camera_rounds): `rounds` times, evenly spaced (1: halfway).
+bool IsCameraRound(int it, int iterations, int rounds);
+
 // Which iterate of a level to keep. `similarities[k]` is the mean
 // similarity of the level's mesh after k iterations (k = 0: its start), the
 // last entry that of the mesh entering the last iteration. Returns the index

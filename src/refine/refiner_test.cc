@@ -99,6 +99,31 @@ TEST(BestIterateToKeep, KeepsTheBestOnlyWhenMuchOfTheGainWasGivenBack) {
 // after its best iterate; the baseline on fandisk-shading, whose similarity
 // also gave back half its gain while the surface kept improving, 0.2 % of
 // 29,791.
+// camera_rounds: evenly spaced rounds within the finest level's iterations,
+// never before its first iteration while there are more iterations than
+// rounds.
+TEST(IsCameraRound, EvenlySpacedRounds) {
+  auto rounds_of = [](int iterations, int rounds) {
+    std::vector<int> at;
+    for (int it = 0; it < iterations; ++it) {
+      if (IsCameraRound(it, iterations, rounds)) at.push_back(it);
+    }
+    return at;
+  };
+  EXPECT_EQ(rounds_of(10, 1), std::vector<int>({5}));
+  EXPECT_EQ(rounds_of(10, 2), std::vector<int>({3, 6}));
+  EXPECT_EQ(rounds_of(10, 3), std::vector<int>({2, 5, 7}));
+  EXPECT_EQ(rounds_of(10, 0), std::vector<int>());
+  EXPECT_EQ(rounds_of(4, 1), std::vector<int>({2}));
+  for (int iterations = 2; iterations <= 20; ++iterations) {
+    for (int rounds = 1; rounds < iterations; ++rounds) {
+      const std::vector<int> at = rounds_of(iterations, rounds);
+      EXPECT_EQ(static_cast<int>(at.size()), rounds) << iterations << " iterations, " << rounds;
+      EXPECT_GT(at.front(), 0) << iterations << " iterations, " << rounds;
+    }
+  }
+}
+
 TEST(MeanResetFraction, SeparatesTheShellFromAPlateau) {
   const std::vector<int> beetle = {9156, 10514, 11157, 12497, 13085, 13673};
   EXPECT_GT(MeanResetFraction(beetle, 37470), kGuardOverrideFraction);
