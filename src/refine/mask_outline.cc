@@ -4,6 +4,7 @@
 #include <cmath>
 #include <limits>
 #include <sstream>
+#include <vector>
 
 #include <opencv2/imgproc.hpp>
 
@@ -56,9 +57,11 @@ std::string MaskOutlineReport::BriefReport() const {
 MaskOutlineReport MeasureMaskOutline(const ViewSource& source, const MaskOutlineOptions& options) {
   options.Check();
   MaskOutlineReport report;
+  // The profile: mean gradient magnitude of the grey image over the pixels
+  // at signed distance [k - band, k - band + 1) from the outline, k = 0 ..
+  // bins - 1 (positive inside the masks).
   const int bins = 2 * static_cast<int>(std::ceil(options.band_px));
   const double band = bins / 2;
-  report.band_px = band;
   std::vector<double> sum(bins, 0.0), count(bins, 0.0);
   const int n = source.NumViews();
   const int step = std::max(1, n / options.max_images);
@@ -86,9 +89,8 @@ MaskOutlineReport MeasureMaskOutline(const ViewSource& source, const MaskOutline
       }
     }
   }
-  report.profile.assign(bins, 0.0);
-  for (int k = 0; k < bins; ++k) report.profile[k] = count[k] > 0 ? sum[k] / count[k] : 0.0;
-  const std::vector<double>& p = report.profile;
+  std::vector<double> p(bins, 0.0);
+  for (int k = 0; k < bins; ++k) p[k] = count[k] > 0 ? sum[k] / count[k] : 0.0;
   const int b = static_cast<int>(std::max_element(p.begin(), p.end()) - p.begin());
   // The value on the outline: the two bins either side of it.
   const double on_outline = 0.5 * (p[bins / 2 - 1] + p[bins / 2]);

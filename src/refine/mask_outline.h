@@ -18,7 +18,6 @@
 // much the masks are off, and they are moved by that much.
 
 #include <string>
-#include <vector>
 
 #include <opencv2/core.hpp>
 
@@ -47,11 +46,6 @@ struct MaskOutlineOptions {
 
 struct MaskOutlineReport {
   int views_measured = 0;
-  // Mean gradient magnitude of the grey image (per pixel, [0, 1] units) over
-  // the pixels at signed distance [k - band, k - band + 1) from the outline,
-  // k = 0 .. 2 band - 1 (positive inside the masks).
-  std::vector<double> profile;
-  double band_px = 0;
   // Where the profile peaks (sub-pixel, positive: inside the masks, so the
   // masks are too large) and how far above the outline's value.
   double edge_offset_px = 0;
