@@ -63,9 +63,7 @@ MaskOutlineReport MeasureMaskOutline(const ViewSource& source, const MaskOutline
   const int bins = 2 * static_cast<int>(std::ceil(options.band_px));
   const double band = bins / 2;
   std::vector<double> sum(bins, 0.0), count(bins, 0.0);
-  const int n = source.NumViews();
-  const int step = std::max(1, n / options.max_images);
-  for (int i = 0; i < n && report.views_measured < options.max_images; i += step) {
+  for (const int i : EvenlySpacedViews(source.NumViews(), options.max_images)) {
     const cv::Mat mask = source.LoadMask(i);
     if (mask.empty()) continue;
     const cv::Mat gray = source.LoadGray(i);

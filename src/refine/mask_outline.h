@@ -60,7 +60,8 @@ struct MaskOutlineReport {
 };
 
 // Measures where the images' edges lie relative to the masks' outlines, over
-// up to options.max_images views that have a mask.
+// the views that have a mask among up to options.max_images evenly spaced
+// ones (EvenlySpacedViews).
 MaskOutlineReport MeasureMaskOutline(const ViewSource& source, const MaskOutlineOptions& options);
 
 // `mask` (CV_8U, nonzero = inside) with its outline moved inwards by

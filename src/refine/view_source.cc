@@ -70,14 +70,18 @@ int WorkspaceViewSource::CameraId(int i) const {
   return static_cast<int>(workspace_.model.images.at(ids_.at(i)).camera_id);
 }
 
+std::vector<int> EvenlySpacedViews(int num_views, int max_views) {
+  const int used = std::min(num_views, std::max(1, max_views));
+  std::vector<int> views(std::max(0, used));
+  for (int k = 0; k < used; ++k) views[k] = static_cast<int>(static_cast<long>(k) * num_views / used);
+  return views;
+}
+
 Eigen::Vector3d PrincipalTextureColor(const ViewSource& source, int max_images,
                                       double sigma_px) {
   Eigen::Matrix3d covariance = Eigen::Matrix3d::Zero();
   double count = 0;
-  const int n = source.NumViews();
-  const int used = std::min(n, std::max(1, max_images));
-  for (int k = 0; k < used; ++k) {
-    const int i = static_cast<int>(static_cast<long>(k) * n / used);
+  for (const int i : EvenlySpacedViews(source.NumViews(), max_images)) {
     const cv::Mat bgr = source.LoadColor(i);
     cv::Mat f, blurred;
     bgr.convertTo(f, CV_32F, bgr.depth() == CV_16U ? 1.0 / 65535 : 1.0 / 255);

@@ -111,6 +111,10 @@ class ResizedViewSource : public DerivedViewSource {
   std::vector<PinholeView> views_;
 };
 
+// Up to `max_views` of views 0 .. num_views - 1, evenly spaced from view 0
+// (all of them when there are no more than max_views; max_views >= 1).
+std::vector<int> EvenlySpacedViews(int num_views, int max_views);
+
 // The colour direction along which the images' texture varies most: the
 // principal eigenvector of the RGB covariance of the images' high-pass part
 // (colour minus its Gaussian blur of `sigma_px`, the scale a ZNCC window
