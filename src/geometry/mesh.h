@@ -19,12 +19,55 @@ double MeanEdgeLength(const Eigen::MatrixXd& V, const Eigen::MatrixXi& F);
 // Length of the bounding-box diagonal of V (0 if empty).
 double BoundingBoxDiagonal(const Eigen::MatrixXd& V);
 
+// Lists of indices stored back to back (compressed rows): list i is
+// values[offsets[i]] .. values[offsets[i + 1] - 1]. One allocation for all of
+// them, where a vector per list costs a malloc each (3M of them for the edges
+// of a 2M-face mesh).
+struct IndexLists {
+  class List {
+   public:
+    List(const int* begin, const int* end) : begin_(begin), end_(end) {}
+    const int* begin() const { return begin_; }
+    const int* end() const { return end_; }
+    size_t size() const { return static_cast<size_t>(end_ - begin_); }
+    int operator[](size_t i) const { return begin_[i]; }
+
+   private:
+    const int* begin_;
+    const int* end_;
+  };
+  class Iterator {
+   public:
+    Iterator(const IndexLists* lists, size_t i) : lists_(lists), i_(i) {}
+    List operator*() const { return (*lists_)[i_]; }
+    Iterator& operator++() {
+      ++i_;
+      return *this;
+    }
+    bool operator!=(const Iterator& other) const { return i_ != other.i_; }
+
+   private:
+    const IndexLists* lists_;
+    size_t i_;
+  };
+
+  std::vector<int> offsets{0};  // size() + 1 entries
+  std::vector<int> values;
+
+  size_t size() const { return offsets.size() - 1; }
+  List operator[](size_t i) const {
+    return List(values.data() + offsets[i], values.data() + offsets[i + 1]);
+  }
+  Iterator begin() const { return Iterator(this, 0); }
+  Iterator end() const { return Iterator(this, size()); }
+};
+
 // Unique undirected edges and their incident faces.
 struct EdgeTopology {
   Eigen::MatrixXi E;  // #E by 2 vertex indices, E(e,0) < E(e,1)
-  // For each edge, the incident faces (1: boundary, 2: manifold interior,
-  // >2: non-manifold).
-  std::vector<std::vector<int>> edge_faces;
+  // For each edge, the incident faces in increasing order (1: boundary, 2:
+  // manifold interior, >2: non-manifold).
+  IndexLists edge_faces;
   // For each face and corner k, the index of the edge opposite corner k
   // (between F(f,(k+1)%3) and F(f,(k+2)%3)).
   Eigen::MatrixXi face_edges;  // #F by 3

@@ -114,7 +114,7 @@ int ProcessVertexFans(const EdgeTopology& topo, Eigen::MatrixXd* V, Eigen::Matri
       const int f = faces[i];
       for (int k = 0; k < 3; ++k) {
         if ((*F)(f, k) == v) continue;  // edge opposite k does not contain v
-        const std::vector<int>& ef = topo.edge_faces[topo.face_edges(f, k)];
+        const IndexLists::List ef = topo.edge_faces[topo.face_edges(f, k)];
         if (ef.size() != 2) continue;  // boundary or non-manifold: a cut
         const int g = ef[0] == f ? ef[1] : ef[0];
         const int j = static_cast<int>(std::find(faces, faces + n, g) - faces);
@@ -163,7 +163,7 @@ int EdgeDirection(const Eigen::MatrixXi& F, int f, int u, int w) {
 int CountInconsistentEdges(const Eigen::MatrixXi& F, const EdgeTopology& topo) {
   int n = 0;
   for (int e = 0; e < topo.E.rows(); ++e) {
-    const std::vector<int>& ef = topo.edge_faces[e];
+    const IndexLists::List ef = topo.edge_faces[e];
     if (ef.size() != 2) continue;
     if (EdgeDirection(F, ef[0], topo.E(e, 0), topo.E(e, 1)) ==
         EdgeDirection(F, ef[1], topo.E(e, 0), topo.E(e, 1)))
@@ -348,7 +348,14 @@ CleanMeshReport CleanMesh(Eigen::MatrixXd* V, Eigen::MatrixXi* F, const CleanMes
   // exists already, neighbour degenerate too) is deleted after three passes.
   {
     const double tol = options.degenerate_area_tolerance;
-    for (int pass = 0; pass < 3; ++pass) {
+    // Most meshes have none: then the edge maps below (3 entries per face,
+    // 3.6 s of a 2M-face input's 6 s clean-up) are not built at all.
+    bool any_degenerate = false;
+    for (int f = 0; f < F->rows() && !any_degenerate; ++f) {
+      int k = 0;
+      any_degenerate = IsDegenerate(*V, *F, f, tol, &k);
+    }
+    for (int pass = 0; pass < 3 && any_degenerate; ++pass) {
       std::unordered_map<uint64_t, int> directed;  // directed edge -> face (-1: several)
       std::unordered_set<uint64_t> undirected;
       directed.reserve(3 * F->rows());
@@ -443,7 +450,7 @@ CleanMeshReport CleanMesh(Eigen::MatrixXd* V, Eigen::MatrixXi* F, const CleanMes
         members.push_back(f);
         for (int k = 0; k < 3; ++k) {
           const int e = topo.face_edges(f, k);
-          const std::vector<int>& ef = topo.edge_faces[e];
+          const IndexLists::List ef = topo.edge_faces[e];
           if (ef.size() != 2) continue;
           const int g = ef[0] == f ? ef[1] : ef[0];
           const int u = topo.E(e, 0), w = topo.E(e, 1);

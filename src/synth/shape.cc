@@ -181,7 +181,7 @@ double MaxDihedralAngleDeg(const Eigen::MatrixXd& V, const Eigen::MatrixXi& F) {
   const Eigen::MatrixXd N = FaceNormals(V, F);
   const EdgeTopology topo = ComputeEdgeTopology(F, static_cast<int>(V.rows()));
   double best = 0;
-  for (const auto& faces : topo.edge_faces) {
+  for (const IndexLists::List faces : topo.edge_faces) {
     if (faces.size() != 2) continue;
     const double c = std::clamp(N.row(faces[0]).dot(N.row(faces[1])), -1.0, 1.0);
     best = std::max(best, std::acos(c) * 180 / kPi);
