@@ -86,20 +86,22 @@ void FromCgal(const Mesh& mesh, Eigen::MatrixXd* V, Eigen::MatrixXi* F) {
   }
 }
 
-// Stops when the mesh has at most `target` faces.
+// Stops when the mesh has at most `target` faces, or when *cancel is set.
 struct FaceCountStop {
   const Mesh* mesh;
   std::size_t target;
+  const std::atomic<bool>* cancel;
   template <typename FT, typename Profile>
   bool operator()(const FT&, const Profile&, std::size_t, std::size_t) const {
-    return mesh->number_of_faces() <= target;
+    return mesh->number_of_faces() <= target ||
+           (cancel != nullptr && cancel->load(std::memory_order_relaxed));
   }
 };
 
 template <typename Cost, typename Placement>
 int CollapseEdges(Mesh* mesh, std::size_t target, const Cost& cost, const Placement& placement,
-                  bool bounded_normal_change) {
-  const FaceCountStop stop{mesh, target};
+                  bool bounded_normal_change, const std::atomic<bool>* cancel) {
+  const FaceCountStop stop{mesh, target, cancel};
   if (bounded_normal_change) {
     const SMS::Bounded_normal_change_filter<> filter;
     return SMS::edge_collapse(
@@ -138,7 +140,8 @@ std::string DecimateSummary::BriefReport() const {
   s << policy << ": faces " << initial_faces << " -> " << final_faces << ", vertices "
     << initial_vertices << " -> " << final_vertices << ", " << collapsed_edges
     << " edges collapsed in " << seconds << " s"
-    << (target_not_reached ? " (target NOT reached: collapses blocked)" : "");
+    << (target_not_reached ? " (target NOT reached: collapses blocked)" : "")
+    << (cancelled ? " (cancelled)" : "");
   return s.str();
 }
 
@@ -165,21 +168,28 @@ DecimateSummary Decimate(Eigen::MatrixXd* V, Eigen::MatrixXi* F, int target_face
   RunCgal("Decimate", [&] {
     if (options.policy == "garland_heckbert") {
       const SMS::GarlandHeckbert_plane_policies<Mesh, Kernel> gh(mesh);
-      summary.collapsed_edges = CollapseEdges(&mesh, target_faces, gh.get_cost(),
-                                              gh.get_placement(), options.bounded_normal_change);
+      summary.collapsed_edges =
+          CollapseEdges(&mesh, target_faces, gh.get_cost(), gh.get_placement(),
+                        options.bounded_normal_change, options.cancel);
     } else {
       summary.collapsed_edges =
           CollapseEdges(&mesh, target_faces, SMS::LindstromTurk_cost<Mesh>(),
-                        SMS::LindstromTurk_placement<Mesh>(), options.bounded_normal_change);
+                        SMS::LindstromTurk_placement<Mesh>(), options.bounded_normal_change,
+                        options.cancel);
     }
   });
   mesh.collect_garbage();
   FromCgal(mesh, V, F);
   summary.final_vertices = V->rows();
   summary.final_faces = F->rows();
-  summary.target_not_reached = F->rows() > target_faces;
+  summary.cancelled = options.cancel != nullptr && options.cancel->load();
+  summary.target_not_reached = F->rows() > target_faces && !summary.cancelled;
   summary.seconds = ElapsedSeconds() - t0;
-  MR_LOG(INFO) << "Decimate: " << summary.BriefReport();
+  if (summary.cancelled) {
+    MR_LOG(VERBOSE) << "Decimate: " << summary.BriefReport();
+  } else {
+    MR_LOG(INFO) << "Decimate: " << summary.BriefReport();
+  }
   if (summary.target_not_reached) {
     MR_LOG(WARNING) << "Decimate: stopped at " << summary.final_faces << " faces (target "
                     << target_faces << "): no admissible collapse left";

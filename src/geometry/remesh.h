@@ -14,6 +14,7 @@
 //
 // Library: mr_remesh (links CGAL; keep it out of mr_geometry).
 
+#include <atomic>
 #include <memory>
 #include <string>
 #include <vector>
@@ -37,6 +38,11 @@ struct DecimateOptions {
   // Reject a collapse if any face of the resulting star turns its normal by
   // 90 degrees or more (CGAL Bounded_normal_change_filter): prevents folds.
   bool bounded_normal_change = true;
+  // When given, the collapses stop as soon as *cancel is true (checked before
+  // each collapse); the mesh is then partly decimated and the summary says
+  // `cancelled`. For a decimation run on another thread whose result may
+  // turn out not to be needed.
+  const std::atomic<bool>* cancel = nullptr;
 
   bool Check() const;
 };
@@ -49,6 +55,7 @@ struct DecimateSummary {
   double seconds = 0;
   // True when the target was not reached (the filter/topology blocked collapses).
   bool target_not_reached = false;
+  bool cancelled = false;  // stopped by DecimateOptions::cancel
   std::string BriefReport() const;
 };
 

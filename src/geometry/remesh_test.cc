@@ -3,12 +3,12 @@
 
 #include <gtest/gtest.h>
 
-#include <random>
-
 #include <algorithm>
+#include <atomic>
 #include <cmath>
 #include <cstdlib>
 #include <limits>
+#include <random>
 
 #include "geometry/mesh.h"
 #include "util/error.h"
@@ -110,6 +110,33 @@ TEST(Decimate, LindstromTurk) {
   EXPECT_NEAR(F.rows(), 1000, 50);
   EXPECT_TRUE(IsClosedManifold(V, F));
   EXPECT_LT(MaxRadiusError(V), 0.02);
+}
+
+// A decimation whose result is no longer wanted (the refiner's background
+// remeshing) stops at its next collapse once the flag is set; without the
+// flag, or with it unset, it runs to the target as before.
+TEST(Decimate, CancelStopsTheCollapses) {
+  Eigen::MatrixXd V;
+  Eigen::MatrixXi F;
+  Icosphere(4, &V, &F);  // 5120 faces
+  std::atomic<bool> cancel{false};
+  DecimateOptions options;
+  options.cancel = &cancel;
+  Eigen::MatrixXd V1 = V;
+  Eigen::MatrixXi F1 = F;
+  const DecimateSummary unset = Decimate(&V1, &F1, 1000, options);
+  EXPECT_FALSE(unset.cancelled);
+  Eigen::MatrixXd V2 = V;
+  Eigen::MatrixXi F2 = F;
+  Decimate(&V2, &F2, 1000);
+  EXPECT_EQ(F1, F2);
+  EXPECT_EQ(V1, V2);
+  cancel = true;
+  const DecimateSummary set = Decimate(&V, &F, 1000, options);
+  EXPECT_TRUE(set.cancelled);
+  EXPECT_FALSE(set.target_not_reached);
+  EXPECT_EQ(set.collapsed_edges, 0);
+  EXPECT_EQ(F.rows(), 5120);
 }
 
 TEST(Decimate, BelowTargetIsUnchanged) {

@@ -1,8 +1,10 @@
 #include "refine/refiner.h"
 
 #include <algorithm>
+#include <atomic>
 #include <cmath>
 #include <functional>
+#include <future>
 #include <iomanip>
 #include <limits>
 #include <list>
@@ -128,8 +130,12 @@ void RefineCamerasAtLevel(const RefineOptions& options,
 }
 
 // Remeshes to the level's target edge length, within the face budget.
-void RemeshForLevel(const std::vector<PinholeView>& views, const RefineOptions& options,
-                    int max_faces, Eigen::MatrixXd* V, Eigen::MatrixXi* F) {
+// Returns false, leaving (V, F) half-done, when *cancel (if given) was set
+// before the end; it is checked during the decimation and between stages.
+bool RemeshForLevel(const std::vector<PinholeView>& views, const RefineOptions& options,
+                    int max_faces, Eigen::MatrixXd* V, Eigen::MatrixXi* F,
+                    const std::atomic<bool>* cancel = nullptr) {
+  auto cancelled = [cancel] { return cancel != nullptr && cancel->load(); };
   const double footprint = MedianFootprint(views, *V, VertexNormals(*V, *F));
   if (!(footprint > 0)) MR_THROW_INPUT << "the mesh is not visible in any view";
   double edge = options.target_edge_px * footprint;
@@ -143,15 +149,19 @@ void RemeshForLevel(const std::vector<PinholeView>& views, const RefineOptions& 
   if (faces_before > 2 * target_faces) {
     // Large reductions by quadric decimation first (Garland-Heckbert), which
     // keeps the shape better than collapsing to length alone.
-    const DecimateSummary decimated = Decimate(V, F, std::max(4, target_faces));
+    DecimateOptions decimate;
+    decimate.cancel = cancel;
+    const DecimateSummary decimated = Decimate(V, F, std::max(4, target_faces), decimate);
     MR_LOG(VERBOSE) << decimated.BriefReport();
   }
+  if (cancelled()) return false;
   const IsotropicRemeshSummary remeshed = IsotropicRemesh(V, F, edge);
   MR_LOG(VERBOSE) << remeshed.BriefReport();
   // The count above is that of equilateral triangles; the remesher's edges
   // come out shorter than its target (mean 0.93x on a 352k-face Poisson mesh
   // remeshed for 1600x1200 images: 820k faces for a budget of 704k), so the
   // budget is enforced by a last, small quadric decimation.
+  if (cancelled()) return false;
   if (F->rows() > max_faces) {
     const DecimateSummary trimmed = Decimate(V, F, max_faces);
     MR_LOG(INFO) << "Remeshed mesh over the face budget (max_faces " << max_faces
@@ -166,7 +176,46 @@ void RemeshForLevel(const std::vector<PinholeView>& views, const RefineOptions& 
   OrderSpatially(V, F);
   MR_LOG(INFO) << "Remeshed " << faces_before << " -> " << F->rows() << " faces (edge "
                << edge / footprint << " px at this level, " << ElapsedSeconds() - t0 << " s)";
+  return true;
 }
+
+// The input remeshed for the full-resolution level on a second thread while
+// the main thread measures the schedule (ChooseNumLevels renders through the
+// GL context, which stays on the main thread). A close start (one level, as
+// for every Poisson mesh of the corpus) begins from it; a coarse-to-fine
+// schedule cancels it. The same RemeshForLevel on the same input as the
+// sequential path, so the result is the same. Cancelled and joined on
+// destruction, also when the main thread unwinds.
+class BackgroundRemesh {
+ public:
+  BackgroundRemesh(std::vector<PinholeView> views, const RefineOptions& options, int max_faces,
+                   Eigen::MatrixXd V, Eigen::MatrixXi F)
+      : V_(std::move(V)), F_(std::move(F)) {
+    result_ = std::async(std::launch::async,
+                         [this, views = std::move(views), &options, max_faces] {
+                           return RemeshForLevel(views, options, max_faces, &V_, &F_, &cancel_);
+                         });
+  }
+  ~BackgroundRemesh() {
+    cancel_ = true;
+    if (result_.valid()) result_.wait();
+  }
+  BackgroundRemesh(const BackgroundRemesh&) = delete;
+  BackgroundRemesh& operator=(const BackgroundRemesh&) = delete;
+
+  // Waits for the remeshed mesh (rethrows what the remeshing threw).
+  void Take(Eigen::MatrixXd* V, Eigen::MatrixXi* F) {
+    MR_CHECK(result_.get()) << "the background remeshing was cancelled";
+    *V = std::move(V_);
+    *F = std::move(F_);
+  }
+
+ private:
+  Eigen::MatrixXd V_;
+  Eigen::MatrixXi F_;
+  std::atomic<bool> cancel_{false};
+  std::future<bool> result_;
+};
 
 // Upper median of `values` (which must not be empty); reorders them.
 template <typename T>
@@ -660,7 +709,10 @@ RefineSummary RefineMesh(const ViewSource& input_source, const RefineOptions& op
   // The schedule: how many pyramid levels, from the input's similarity at
   // each level (ChooseNumLevels), unless num_levels is given.
   int num_levels = options.num_levels;
+  std::unique_ptr<BackgroundRemesh> full_resolution_remesh;
   if (num_levels == 0) {
+    full_resolution_remesh = std::make_unique<BackgroundRemesh>(LevelViews(cameras, 0), options,
+                                                                max_faces, V, F);
     const Schedule schedule = ChooseNumLevels(source, pairs, options, V, F, renderer,
                                               cache_bytes / 2, &images);
     num_levels = schedule.num_levels;
@@ -684,6 +736,7 @@ RefineSummary RefineMesh(const ViewSource& input_source, const RefineOptions& op
                         " faces < " + std::to_string(kMinLevelFaces) + ")";
     --num_levels;
   }
+  if (num_levels > 1) full_resolution_remesh.reset();  // cancelled: coarse to fine
   // With one level the first iteration measures the same thing (plain ZNCC
   // of all pairs at full resolution; κ does not enter m) on the input
   // remeshed to the working resolution, so it is taken from there.
@@ -700,7 +753,12 @@ RefineSummary RefineMesh(const ViewSource& input_source, const RefineOptions& op
   summary.setup_seconds = ElapsedSeconds() - t_start;
   for (int level = num_levels - 1; level >= 0; --level) {
     std::vector<PinholeView> views = LevelViews(cameras, level);
-    RemeshForLevel(views, options, max_faces, &V, &F);
+    if (full_resolution_remesh) {
+      full_resolution_remesh->Take(&V, &F);
+      full_resolution_remesh.reset();
+    } else {
+      RemeshForLevel(views, options, max_faces, &V, &F);
+    }
     // Not at the first level's start: the input mesh (a Poisson surface, a
     // visual hull) is too far off for the images to tell its errors from
     // the cameras', and cameras fitted to it drift (measured on the corpus,

@@ -277,8 +277,11 @@ struct RefineSummary {
   double seconds = 0;
   // Where the time went outside the iterations: loading the mesh, cleaning
   // it, view selection and the schedule; remeshing for the levels (and the
-  // rest of their set-up: the self-intersection guard, the render cache); the final self-intersection check,
-  // similarity and vertex colours.
+  // rest of their set-up: the self-intersection guard, the render cache;
+  // with a chosen schedule the full-resolution remeshing runs alongside the
+  // schedule's measurement, and only what is left of it after the
+  // measurement counts here); the final self-intersection check, similarity
+  // and vertex colours.
   double setup_seconds = 0, remesh_seconds = 0, final_seconds = 0;
   std::vector<RefineIteration> iterations;
   // refine_cameras: the refined cameras of the views (pose and intrinsics at

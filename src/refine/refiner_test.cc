@@ -640,6 +640,17 @@ TEST_F(RefinerTest, ScheduleFollowsTheStart) {
   close.F = F;
   const RefineSummary close_summary = RefineMesh(source, options, &close, renderer_);
   EXPECT_EQ(close_summary.iterations.front().level, 0) << close_summary.schedule;
+  // The chosen one-level schedule starts from the remeshing done on the
+  // second thread while the schedule was measured; it must be the surface
+  // the sequential path makes when one level is given.
+  RefineOptions one_level = options;
+  one_level.num_levels = 1;
+  TriangleMesh given;
+  given.V = V;
+  given.F = F;
+  RefineMesh(source, one_level, &given, renderer_);
+  EXPECT_EQ(close.F, given.F);
+  EXPECT_EQ(close.V, given.V);
   TriangleMesh far;
   MakeIcosphere(4, 1.12, &far.V, &far.F);
   const RefineSummary far_summary = RefineMesh(source, options, &far, renderer_);
