@@ -33,6 +33,9 @@ int main(int argc, char** argv) {
     options.Add("shape", &o.shape, "built-in shape when no model_path: builtin");
     options.Add("scene_diagonal", &o.scene_diagonal,
                 "bounding-box diagonal of the normalised ground truth (scene units)");
+    options.Add("ground_plane_radius", &o.ground_plane_radius,
+                "a textured ground under the object, half-side in object radii (part of the "
+                "ground truth); 0 = none, black background");
     options.Add("num_views", &o.cameras.num_views, "number of views");
     options.Add("width", &o.cameras.width, "image width (pixels)");
     options.Add("height", &o.cameras.height, "image height (pixels)");

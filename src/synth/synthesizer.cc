@@ -59,6 +59,36 @@ TriangleMesh LoadGroundTruth(const SynthesizerOptions& options) {
   return mesh;
 }
 
+// Appends to `mesh` a square ground of half-side `half_side` centred under
+// the origin at the mesh's lowest point, facing +z: a grid of `cells` x
+// `cells` squares, so that no triangle is much larger than the object's
+// screen (the evaluator samples faces, the renderer clips them).
+void AppendGroundPlane(double half_side, int cells, TriangleMesh* mesh) {
+  const double z = mesh->V.col(2).minCoeff();
+  const int base = static_cast<int>(mesh->V.rows());
+  const int n = cells + 1;
+  Eigen::MatrixXd V(mesh->V.rows() + n * n, 3);
+  V.topRows(mesh->V.rows()) = mesh->V;
+  for (int i = 0; i < n; ++i) {
+    for (int j = 0; j < n; ++j) {
+      V.row(base + i * n + j) << -half_side + 2 * half_side * j / cells,
+          -half_side + 2 * half_side * i / cells, z;
+    }
+  }
+  Eigen::MatrixXi F(mesh->F.rows() + 2 * cells * cells, 3);
+  F.topRows(mesh->F.rows()) = mesh->F;
+  int f = static_cast<int>(mesh->F.rows());
+  for (int i = 0; i < cells; ++i) {
+    for (int j = 0; j < cells; ++j) {
+      const int a = base + i * n + j, b = a + 1, c = a + n, d = c + 1;
+      F.row(f++) << a, b, d;  // counter-clockwise seen from +z
+      F.row(f++) << a, d, c;
+    }
+  }
+  mesh->V = std::move(V);
+  mesh->F = std::move(F);
+}
+
 }  // namespace
 
 bool SynthesizerOptions::Check() const {
@@ -76,6 +106,10 @@ bool SynthesizerOptions::Check() const {
   if (!(scene_diagonal > 0 && scene_diagonal <= 1e6)) {
     MR_THROW_INPUT << "SynthesizerOptions::scene_diagonal = " << scene_diagonal
                    << ". Violated constraint: 0 < scene_diagonal <= 1e6";
+  }
+  if (!(ground_plane_radius == 0 || (ground_plane_radius >= 1 && ground_plane_radius <= 100))) {
+    MR_THROW_INPUT << "SynthesizerOptions::ground_plane_radius = " << ground_plane_radius
+                   << ". Violated constraint: 0 (none) or 1 <= ground_plane_radius <= 100";
   }
   if (supersample < 1 || supersample > 8) {
     MR_THROW_INPUT << "SynthesizerOptions::supersample = " << supersample
@@ -153,7 +187,12 @@ SynthesizerSummary SynthesizeWorkspace(const SynthesizerOptions& options) {
 
   // Ground truth.
   double t0 = ElapsedSeconds();
-  const TriangleMesh gt = LoadGroundTruth(options);
+  TriangleMesh gt = LoadGroundTruth(options);
+  // The cameras frame the object, not the ground.
+  const double radius = gt.V.rowwise().norm().maxCoeff();
+  if (options.ground_plane_radius > 0) {
+    AppendGroundPlane(options.ground_plane_radius * radius, 64, &gt);
+  }
   summary.num_gt_vertices = gt.NumVertices();
   summary.num_gt_faces = gt.NumFaces();
   CreateDirIfNotExists(options.output_path);
@@ -161,7 +200,8 @@ SynthesizerSummary SynthesizeWorkspace(const SynthesizerOptions& options) {
   MR_LOG(INFO) << "Ground truth: " << gt.NumVertices() << " vertices, " << gt.NumFaces()
                << " faces ("
                << (options.model_path.empty() ? "built-in shape" : options.model_path)
-               << ", bounding-box diagonal " << options.scene_diagonal << ") in "
+               << ", bounding-box diagonal " << options.scene_diagonal << ")"
+               << (options.ground_plane_radius > 0 ? ", with a ground plane" : "") << " in "
                << ElapsedSeconds() - t0 << " s";
 
   SynthScene scene;
@@ -169,7 +209,6 @@ SynthesizerSummary SynthesizeWorkspace(const SynthesizerOptions& options) {
   scene.F = gt.F;
   scene.face_normals = FaceNormals(gt.V, gt.F);
   scene.appearance = options.appearance;
-  const double radius = gt.V.rowwise().norm().maxCoeff();
   const std::vector<PinholeView> views = MakeCameras(options.cameras, radius);
   summary.num_views = static_cast<int>(views.size());
 

@@ -40,6 +40,12 @@ struct SynthesizerOptions {
   std::string shape = "builtin";
   // Bounding-box diagonal of the normalised ground truth (scene units). (0, 1e6].
   double scene_diagonal = 100;
+  // A flat ground under the object, as in photographs of a thing on a table:
+  // a square of half-side ground_plane_radius x the object's bounding radius
+  // at the object's lowest point, textured like the object and part of the
+  // ground truth (the cameras still frame the object). 0 = none (a black
+  // background). [0, 100]. Masks, if written, then cover the ground too.
+  double ground_plane_radius = 0;
   // Image supersampling factor per axis for anti-aliasing. Range [1, 8].
   int supersample = 3;
   // Standard deviation of the white Gaussian noise added to every pixel and

@@ -368,6 +368,43 @@ TEST(Synthesizer, ModelUpAxisIsRotatedOntoZ) {
   EXPECT_THROW(bad.Check(), InputError);
 }
 
+// The ground is part of the ground truth and of the images, under the
+// object's lowest point; the cameras still frame the object alone.
+TEST(Synthesizer, GroundPlaneUnderTheObject) {
+  const std::string dir = FreshDir("ground");
+  SynthesizerOptions plain = SmallOptions(JoinPaths(dir, "plain"));
+  const SynthesizerSummary without = SynthesizeWorkspace(plain);
+  SynthesizerOptions options = SmallOptions(JoinPaths(dir, "ground"));
+  options.ground_plane_radius = 3;
+  const SynthesizerSummary with = SynthesizeWorkspace(options);
+  EXPECT_EQ(with.num_gt_faces, without.num_gt_faces + 2 * 64 * 64);
+  const TriangleMesh object = ReadPly(JoinPaths(plain.output_path, "ground_truth.ply"));
+  const TriangleMesh scene = ReadPly(JoinPaths(options.output_path, "ground_truth.ply"));
+  ASSERT_EQ(scene.NumVertices(), object.NumVertices() + 65 * 65);
+  EXPECT_TRUE(scene.V.topRows(object.NumVertices()) == object.V);
+  const double radius = object.V.rowwise().norm().maxCoeff();
+  const Eigen::MatrixXd ground = scene.V.bottomRows(65 * 65);
+  EXPECT_DOUBLE_EQ(ground.col(2).minCoeff(), object.V.col(2).minCoeff());
+  EXPECT_DOUBLE_EQ(ground.col(2).maxCoeff(), object.V.col(2).minCoeff());
+  EXPECT_NEAR(ground.col(0).maxCoeff(), 3 * radius, 1e-3);  // float PLY
+  EXPECT_NEAR(ground.col(1).minCoeff(), -3 * radius, 1e-3);
+  // Facing up.
+  const Eigen::MatrixXd N = FaceNormals(scene.V, scene.F);
+  EXPECT_NEAR(N(scene.NumFaces() - 1, 2), 1.0, 1e-9);
+  // The same cameras, and more of every image covered.
+  const Reconstruction a = ReadSparseModel(JoinPaths(plain.output_path, "dense/sparse"));
+  const Reconstruction b = ReadSparseModel(JoinPaths(options.output_path, "dense/sparse"));
+  for (const auto& [id, image] : a.images) {
+    EXPECT_TRUE(b.images.at(id).tvec.isApprox(image.tvec, 1e-12));
+  }
+  EXPECT_GT(with.mean_coverage, without.mean_coverage + 0.1);
+  SynthesizerOptions bad = SmallOptions(JoinPaths(dir, "bad"));
+  bad.ground_plane_radius = 0.5;  // inside the object
+  EXPECT_THROW(bad.Check(), InputError);
+  bad.ground_plane_radius = -1;
+  EXPECT_THROW(bad.Check(), InputError);
+}
+
 TEST(ColmapRunner, HelpersAndFailureMessage) {
   EXPECT_FALSE(FindExecutable("sh").empty());
   EXPECT_TRUE(FindExecutable("no_such_program_mr_synth").empty());
