@@ -117,6 +117,43 @@ TEST_F(MeshProgramsCli, EvaluatorWriteConfigOverInputIsRefused) {
   EXPECT_NE(r.output.find("accuracy90"), std::string::npos) << r.output;
 }
 
+// --region_box keeps the ground truth whose faces' centroids lie in the box:
+// a second octahedron 10 units away, missing from the mesh, leaves the
+// completeness at about half without it and whole with a box around the
+// first one.
+TEST_F(MeshProgramsCli, EvaluatorRegionBox) {
+  TriangleMesh gt = Octahedron(1.01);
+  const TriangleMesh far = Octahedron(1.01);
+  gt.V.conservativeResize(12, 3);
+  gt.V.bottomRows(6) = far.V.rowwise() + Eigen::RowVector3d(10, 0, 0);
+  gt.F.conservativeResize(16, 3);
+  gt.F.bottomRows(8) = far.F.array() + 6;
+  WritePly(dir_ + "/two.ply", gt);
+  const std::string evaluate = kEvaluator + " --input_path " + dir_ + "/m.ply --gt_path " + dir_ +
+                               "/two.ply --num_samples 4000 --threshold 0.05";
+  const auto number = [](const std::string& json, const std::string& key) {
+    const size_t at = json.find("\"" + key + "\": ");
+    EXPECT_NE(at, std::string::npos) << key << " in " << json;
+    return at == std::string::npos ? -1.0 : std::stod(json.substr(at + key.size() + 4));
+  };
+  const CommandResult all = RunCommand(evaluate);
+  ASSERT_EQ(all.exit_code, 0) << all.output;
+  EXPECT_NEAR(number(all.output, "completeness"), 50, 3) << all.output;
+  const CommandResult box = RunCommand(evaluate + " --region_box \"-2 -2 -2 2 2 2\"");
+  ASSERT_EQ(box.exit_code, 0) << box.output;
+  EXPECT_GT(number(box.output, "completeness"), 99) << box.output;
+  EXPECT_NEAR(number(box.output, "observed_percent"), 50, 1e-6) << box.output;
+  EXPECT_LT(number(box.output, "accuracy90"), 0.02) << box.output;
+  const CommandResult commas = RunCommand(evaluate + " --region_box -2,-2,-2,2,2,2");
+  ASSERT_EQ(commas.exit_code, 0) << commas.output;
+  EXPECT_EQ(commas.output, box.output);
+  for (const std::string bad : {"1 2 3", "0 0 0 -1 1 1", "a b c d e f", "0 0 0 1 1 1 7"}) {
+    ExpectRefused(evaluate + " --region_box \"" + bad + "\"", "expected six numbers");
+  }
+  ExpectRefused(evaluate + " --region_box \"50 50 50 60 60 60\"",
+                "no (observed) ground-truth face");
+}
+
 // The other programs name their inputs too: --write_config is refused over
 // a workspace's model or lists, into a Middlebury data set folder, and over
 // a second mesh. (Refused before the inputs are read, so stand-ins do.)
