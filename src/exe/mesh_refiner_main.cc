@@ -158,9 +158,15 @@ void PrintSummary(const Workspace& workspace, const ViewSource& source, const Tr
                 refine.align_masks ? "" : " (--Refine.align_masks 0: used as given)");
   }
   const int max_faces = refine.FaceBudget(mesh.NumFaces());
-  std::printf("Faces at the finest level: about %d (%.2g px edges, at most %d)\n",
-              RemeshedFaceCount(working.Views(), mesh.V, mesh.F, refine.target_edge_px, max_faces),
-              refine.target_edge_px, max_faces);
+  const EdgeSizing sizing(working.Views(), mesh.V, mesh.F, refine.target_edge_px, max_faces);
+  std::printf("Faces at the finest level: about %d (%.2g px edges%s, at most %d)\n",
+              sizing.visible() ? sizing.expected_faces() : 0,
+              sizing.visible() ? sizing.edge_px() : refine.target_edge_px,
+              sizing.uniform() ? ""
+                               : (" in " + std::to_string(sizing.band_edges().size()) +
+                                  " octaves of depth")
+                                     .c_str(),
+              max_faces);
 }
 
 int Run(int argc, char** argv) {

@@ -247,25 +247,28 @@ std::string IsotropicRemeshSummary::BriefReport() const {
   return s.str();
 }
 
-IsotropicRemeshSummary IsotropicRemesh(Eigen::MatrixXd* V, Eigen::MatrixXi* F,
-                                       double target_edge_length,
-                                       const IsotropicRemeshOptions& options) {
+namespace {
+
+// The isotropic remeshing of IsotropicRemesh and IsotropicRemeshBands:
+// `passes` gets the CGAL mesh, the constrained-edge map and whether any edge
+// is protected, and runs CGAL's remeshing on it.
+template <typename Passes>
+IsotropicRemeshSummary RemeshIsotropically(const char* what, Eigen::MatrixXd* V,
+                                           Eigen::MatrixXi* F, double shortest_edge,
+                                           const IsotropicRemeshOptions& options,
+                                           const Passes& passes) {
   MR_CHECK(V != nullptr && F != nullptr);
   options.Check();
-  if (!(target_edge_length > 0) || !std::isfinite(target_edge_length)) {
-    MR_THROW_INPUT << "IsotropicRemesh: target_edge_length = " << target_edge_length
-                   << ". Violated constraint: target_edge_length > 0 (finite)";
-  }
-  CheckMeshInput(*V, *F, "IsotropicRemesh");
+  CheckMeshInput(*V, *F, what);
   const double t0 = ElapsedSeconds();
   IsotropicRemeshSummary summary;
-  summary.target_edge_length = target_edge_length;
+  summary.target_edge_length = shortest_edge;
   summary.initial_vertices = summary.final_vertices = V->rows();
   summary.initial_faces = summary.final_faces = F->rows();
   summary.initial_mean_edge_length = summary.final_mean_edge_length = MeanEdgeLength(*V, *F);
   if (F->rows() == 0) return summary;
-  Mesh mesh = ToCgal(*V, *F, "IsotropicRemesh");
-  RunCgal("IsotropicRemesh", [&] {
+  Mesh mesh = ToCgal(*V, *F, what);
+  RunCgal(what, [&] {
     auto constrained = mesh.add_property_map<Mesh::Edge_index, bool>("e:mr_constrained", false).first;
     if (options.protect_border) {
       for (Mesh::Edge_index e : mesh.edges()) {
@@ -288,16 +291,12 @@ IsotropicRemeshSummary IsotropicRemesh(Eigen::MatrixXd* V, Eigen::MatrixXi* F,
     if (protect) {
       // CGAL can only protect edges <= 4/3 of the target: split them first
       // (the pieces stay constrained).
-      PMP::split_long_edges(protected_edges, target_edge_length, mesh,
+      PMP::split_long_edges(protected_edges, shortest_edge, mesh,
                             CGAL::parameters::edge_is_constrained_map(constrained));
       summary.protected_edges = 0;
       for (Mesh::Edge_index e : mesh.edges()) summary.protected_edges += constrained[e] ? 1 : 0;
     }
-    PMP::isotropic_remeshing(faces(mesh), target_edge_length, mesh,
-                             CGAL::parameters::number_of_iterations(options.iterations)
-                                 .number_of_relaxation_steps(options.relaxation_steps)
-                                 .protect_constraints(protect)
-                                 .edge_is_constrained_map(constrained));
+    passes(mesh, constrained, protect);
     mesh.remove_property_map(constrained);
   });
   mesh.collect_garbage();
@@ -306,7 +305,79 @@ IsotropicRemeshSummary IsotropicRemesh(Eigen::MatrixXd* V, Eigen::MatrixXi* F,
   summary.final_faces = F->rows();
   summary.final_mean_edge_length = MeanEdgeLength(*V, *F);
   summary.seconds = ElapsedSeconds() - t0;
+  return summary;
+}
+
+void CheckEdgeLength(const char* what, double length) {
+  if (!(length > 0) || !std::isfinite(length)) {
+    MR_THROW_INPUT << what << ": target_edge_length = " << length
+                   << ". Violated constraint: target_edge_length > 0 (finite)";
+  }
+}
+
+}  // namespace
+
+IsotropicRemeshSummary IsotropicRemesh(Eigen::MatrixXd* V, Eigen::MatrixXi* F,
+                                       double target_edge_length,
+                                       const IsotropicRemeshOptions& options) {
+  CheckEdgeLength("IsotropicRemesh", target_edge_length);
+  const IsotropicRemeshSummary summary = RemeshIsotropically(
+      "IsotropicRemesh", V, F, target_edge_length, options,
+      [&](Mesh& mesh, auto& constrained, bool protect) {
+        PMP::isotropic_remeshing(faces(mesh), target_edge_length, mesh,
+                                 CGAL::parameters::number_of_iterations(options.iterations)
+                                     .number_of_relaxation_steps(options.relaxation_steps)
+                                     .protect_constraints(protect)
+                                     .edge_is_constrained_map(constrained));
+      });
   MR_LOG(INFO) << "IsotropicRemesh: " << summary.BriefReport();
+  return summary;
+}
+
+IsotropicRemeshSummary IsotropicRemeshBands(Eigen::MatrixXd* V, Eigen::MatrixXi* F,
+                                            const std::vector<double>& band_edges,
+                                            const RemeshBandOf& band_of,
+                                            const IsotropicRemeshOptions& options) {
+  MR_CHECK(!band_edges.empty()) << "IsotropicRemeshBands: no band";
+  for (const double e : band_edges) CheckEdgeLength("IsotropicRemeshBands", e);
+  std::vector<int> order(band_edges.size());
+  for (size_t b = 0; b < order.size(); ++b) order[b] = static_cast<int>(b);
+  std::stable_sort(order.begin(), order.end(),
+                   [&](int a, int b) { return band_edges[a] > band_edges[b]; });
+  const double shortest = band_edges[order.back()];
+  std::ostringstream passes_report;
+  const IsotropicRemeshSummary summary = RemeshIsotropically(
+      "IsotropicRemeshBands", V, F, shortest, options,
+      [&](Mesh& mesh, auto& constrained, bool protect) {
+        for (const int band : order) {
+          std::vector<Mesh::Face_index> patch;
+          for (Mesh::Face_index f : mesh.faces()) {
+            Eigen::Vector3d p[3];
+            int k = 0;
+            for (Mesh::Vertex_index v : vertices_around_face(mesh.halfedge(f), mesh)) {
+              const auto& q = mesh.point(v);
+              p[k++] = Eigen::Vector3d(q.x(), q.y(), q.z());
+            }
+            const Eigen::Vector3d n = (p[1] - p[0]).cross(p[2] - p[0]);
+            const double norm = n.norm();
+            const int b = band_of((p[0] + p[1] + p[2]) / 3.0,
+                                  norm > 0 ? Eigen::Vector3d(n / norm) : Eigen::Vector3d::Zero());
+            MR_CHECK(b >= 0 && b < static_cast<int>(band_edges.size()))
+                << "IsotropicRemeshBands: band " << b << " of " << band_edges.size();
+            if (b == band) patch.push_back(f);
+          }
+          passes_report << (passes_report.tellp() > 0 ? ", " : "") << patch.size() << " faces at "
+                        << band_edges[band];
+          if (patch.empty()) continue;
+          PMP::isotropic_remeshing(patch, band_edges[band], mesh,
+                                   CGAL::parameters::number_of_iterations(options.iterations)
+                                       .number_of_relaxation_steps(options.relaxation_steps)
+                                       .protect_constraints(protect)
+                                       .edge_is_constrained_map(constrained));
+        }
+      });
+  MR_LOG(INFO) << "IsotropicRemeshBands (" << passes_report.str() << "): "
+               << summary.BriefReport();
   return summary;
 }
 

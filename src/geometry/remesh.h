@@ -16,6 +16,7 @@
 
 #include <atomic>
 #include <memory>
+#include <functional>
 #include <string>
 #include <vector>
 
@@ -123,12 +124,30 @@ struct IsotropicRemeshSummary {
 };
 
 // Remeshes towards edges of length `target_edge_length` (> 0, in the units of
-// V). Needs an oriented 2-manifold. In place. (CGAL 5.5 has no adaptive
-// sizing field; an adaptive variant is not provided.)
+// V). Needs an oriented 2-manifold. In place.
 IsotropicRemeshSummary IsotropicRemesh(Eigen::MatrixXd* V, Eigen::MatrixXi* F,
                                        double target_edge_length,
                                        const IsotropicRemeshOptions& options =
                                            IsotropicRemeshOptions());
+
+// Which of the bands of IsotropicRemeshBands a face belongs to, from its
+// centroid and unit normal: an index into the band edge lengths.
+using RemeshBandOf = std::function<int(const Eigen::Vector3d& centroid,
+                                       const Eigen::Vector3d& normal)>;
+
+// Remeshes with an edge length that varies in steps (CGAL 5.5 has no
+// adaptive sizing field): every face goes to the band `band_of` gives it,
+// and each band is remeshed as a patch towards its own length
+// `band_edges[b]` (> 0), from the longest to the shortest. The bands are
+// recomputed from the faces before each pass, so that where two bands meet
+// the shorter edges are made last. CGAL keeps a patch's border (it splits
+// but does not collapse those edges). Border edges are protected at the
+// shortest length. The summary's target is the shortest length.
+IsotropicRemeshSummary IsotropicRemeshBands(Eigen::MatrixXd* V, Eigen::MatrixXi* F,
+                                            const std::vector<double>& band_edges,
+                                            const RemeshBandOf& band_of,
+                                            const IsotropicRemeshOptions& options =
+                                                IsotropicRemeshOptions());
 
 // ---------------------------------------------------------------------------
 // Cleaning (Eigen only; works on arbitrary triangle soups).

@@ -240,6 +240,58 @@ TEST(IsotropicRemesh, ProtectedBorderStaysOnInputBorder) {
   }
 }
 
+// Each band gets its own length: the western half of a unit icosphere
+// remeshed towards 0.06, the eastern towards 0.24, from a mesh of ~0.05.
+TEST(IsotropicRemeshBands, EachBandReachesItsLength) {
+  Eigen::MatrixXd V;
+  Eigen::MatrixXi F;
+  Icosphere(4, &V, &F);
+  const std::vector<double> edges = {0.06, 0.24};
+  const RemeshBandOf band_of = [](const Eigen::Vector3d& c, const Eigen::Vector3d&) {
+    return c.x() < 0 ? 0 : 1;
+  };
+  IsotropicRemeshBands(&V, &F, edges, band_of);
+  EXPECT_TRUE(IsClosedManifold(V, F));
+  EXPECT_LT(MaxRadiusError(V), 0.02);
+  const EdgeTopology topo = ComputeEdgeTopology(F, V.rows());
+  double sum[2] = {0, 0};
+  int count[2] = {0, 0};
+  for (int e = 0; e < topo.E.rows(); ++e) {
+    const Eigen::Vector3d a = V.row(topo.E(e, 0)), b = V.row(topo.E(e, 1));
+    const double x = 0.5 * (a.x() + b.x());
+    if (std::abs(x) < 0.3) continue;  // the seam, where the bands meet
+    sum[x < 0 ? 0 : 1] += (a - b).norm();
+    ++count[x < 0 ? 0 : 1];
+  }
+  ASSERT_GT(count[0], 0);
+  ASSERT_GT(count[1], 0);
+  EXPECT_NEAR(sum[0] / count[0], edges[0], 0.2 * edges[0]);
+  EXPECT_NEAR(sum[1] / count[1], edges[1], 0.2 * edges[1]);
+  // One band is IsotropicRemesh.
+  Eigen::MatrixXd V1, V2;
+  Eigen::MatrixXi F1, F2;
+  Icosphere(3, &V1, &F1);
+  V2 = V1;
+  F2 = F1;
+  IsotropicRemesh(&V1, &F1, 0.15);
+  IsotropicRemeshBands(&V2, &F2, {0.15},
+                       [](const Eigen::Vector3d&, const Eigen::Vector3d&) { return 0; });
+  EXPECT_EQ(F1, F2);
+  EXPECT_EQ(V1, V2);
+}
+
+TEST(IsotropicRemeshBands, InvalidBands) {
+  Eigen::MatrixXd V;
+  Eigen::MatrixXi F;
+  Icosphere(1, &V, &F);
+  const RemeshBandOf zero = [](const Eigen::Vector3d&, const Eigen::Vector3d&) { return 0; };
+  EXPECT_THROW(IsotropicRemeshBands(&V, &F, {0.1, -1.0}, zero), InputError);
+  const RemeshBandOf out_of_range = [](const Eigen::Vector3d&, const Eigen::Vector3d&) {
+    return 2;
+  };
+  EXPECT_ANY_THROW(IsotropicRemeshBands(&V, &F, {0.1, 0.2}, out_of_range));
+}
+
 TEST(IsotropicRemesh, InvalidTarget) {
   Eigen::MatrixXd V;
   Eigen::MatrixXi F;

@@ -136,14 +136,9 @@ bool RemeshForLevel(const std::vector<PinholeView>& views, const RefineOptions& 
                     int max_faces, Eigen::MatrixXd* V, Eigen::MatrixXi* F,
                     const std::atomic<bool>* cancel = nullptr) {
   auto cancelled = [cancel] { return cancel != nullptr && cancel->load(); };
-  const double footprint = MedianFootprint(views, *V, VertexNormals(*V, *F));
-  if (!(footprint > 0)) MR_THROW_INPUT << "the mesh is not visible in any view";
-  double edge = options.target_edge_px * footprint;
-  // Faces of an isotropic mesh with this edge length: area / (√3/4 e²).
-  const double area = FaceAreas(*V, *F).sum();
-  const double faces_at_edge = area / (std::sqrt(3.0) / 4.0 * edge * edge);
-  if (faces_at_edge > max_faces) edge *= std::sqrt(faces_at_edge / max_faces);
-  const int target_faces = static_cast<int>(area / (std::sqrt(3.0) / 4.0 * edge * edge));
+  const EdgeSizing sizing(views, *V, *F, options.target_edge_px, max_faces);
+  if (!sizing.visible()) MR_THROW_INPUT << "the mesh is not visible in any view";
+  const int target_faces = sizing.expected_faces();
   const double t0 = ElapsedSeconds();
   const int faces_before = static_cast<int>(F->rows());
   if (faces_before > 2 * target_faces) {
@@ -155,8 +150,14 @@ bool RemeshForLevel(const std::vector<PinholeView>& views, const RefineOptions& 
     MR_LOG(VERBOSE) << decimated.BriefReport();
   }
   if (cancelled()) return false;
-  const IsotropicRemeshSummary remeshed = IsotropicRemesh(V, F, edge);
-  MR_LOG(VERBOSE) << remeshed.BriefReport();
+  if (sizing.uniform()) {
+    IsotropicRemesh(V, F, sizing.band_edges()[0]);
+  } else {
+    IsotropicRemeshBands(V, F, sizing.band_edges(),
+                         [&sizing](const Eigen::Vector3d& x, const Eigen::Vector3d& n) {
+                           return sizing.BandOf(x, n);
+                         });
+  }
   // The count above is that of equilateral triangles; the remesher's edges
   // come out shorter than its target (mean 0.93x on a 352k-face Poisson mesh
   // remeshed for 1600x1200 images: 820k faces for a budget of 704k), so the
@@ -174,8 +175,15 @@ bool RemeshForLevel(const std::vector<PinholeView>& views, const RefineOptions& 
   // on the order of its input, and ordering the input moved the corpus's
   // results by up to 4 % either way for 1.3 s of the example's time.
   OrderSpatially(V, F);
+  std::ostringstream edges;
+  if (!sizing.uniform()) {
+    edges << " of each point's median footprint: " << sizing.band_edges().size()
+          << " octaves, " << sizing.band_edges().front() << " to " << sizing.band_edges().back()
+          << " scene units";
+  }
   MR_LOG(INFO) << "Remeshed " << faces_before << " -> " << F->rows() << " faces (edge "
-               << edge / footprint << " px at this level, " << ElapsedSeconds() - t0 << " s)";
+               << sizing.edge_px() << " px at this level" << edges.str() << ", "
+               << ElapsedSeconds() - t0 << " s)";
   return true;
 }
 

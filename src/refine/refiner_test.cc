@@ -323,6 +323,62 @@ TEST_F(RefinerTest, FaceBudgetIsRespected) {
   }
 }
 
+// A scene in depth: a bumpy sphere on a ground that reaches 8 radii out.
+// The far ground is remeshed with longer edges than the sphere (its pixels
+// cover more), where one length for the whole mesh gave both the same.
+TEST_F(RefinerTest, EdgesFollowTheFootprintInDepth) {
+  Eigen::MatrixXd V;
+  Eigen::MatrixXi F;
+  MakeBumpySphere(4, 0.03, &V, &F);
+  const int sphere_faces = static_cast<int>(F.rows());
+  const int n = 32, base = static_cast<int>(V.rows());
+  V.conservativeResize(base + (n + 1) * (n + 1), 3);
+  F.conservativeResize(sphere_faces + 2 * n * n, 3);
+  for (int i = 0; i <= n; ++i) {
+    for (int j = 0; j <= n; ++j) V.row(base + i * (n + 1) + j) << -8 + 16.0 * j / n, -8 + 16.0 * i / n, -1.05;
+  }
+  for (int i = 0, f = sphere_faces; i < n; ++i) {
+    for (int j = 0; j < n; ++j) {
+      const int a = base + i * (n + 1) + j, b = a + 1, c = a + n + 1, d = c + 1;
+      F.row(f++) << a, b, d;  // facing up
+      F.row(f++) << a, d, c;
+    }
+  }
+  const InMemoryViewSource source = MakeTestScene(V, F, {}, {}, renderer_);
+  TriangleMesh mesh;
+  mesh.V = V;
+  mesh.F = F;
+  RefineOptions options;
+  options.num_levels = 1;
+  options.iterations_per_level = 0;
+  options.max_faces = 1000000;
+  RefineMesh(source, options, &mesh, renderer_);
+  // Mean edge length of the faces on the sphere and on the ground beyond 5
+  // radii.
+  double sum[2] = {0, 0};
+  int count[2] = {0, 0};
+  for (int f = 0; f < mesh.F.rows(); ++f) {
+    const Eigen::Vector3d a = mesh.V.row(mesh.F(f, 0)), b = mesh.V.row(mesh.F(f, 1)),
+                          c = mesh.V.row(mesh.F(f, 2));
+    const Eigen::Vector3d centre = (a + b + c) / 3;
+    const int where = centre.norm() < 1.2 ? 0 : centre.head<2>().norm() > 5 ? 1 : -1;
+    if (where < 0) continue;
+    sum[where] += ((a - b).norm() + (b - c).norm() + (c - a).norm()) / 3;
+    ++count[where];
+  }
+  ASSERT_GT(count[0], 100);
+  ASSERT_GT(count[1], 100);
+  const double sphere_edge = sum[0] / count[0], far_edge = sum[1] / count[1];
+  EXPECT_GT(far_edge, 1.8 * sphere_edge) << sphere_edge << " " << far_edge;
+  // The sphere keeps the length its own footprint asks for.
+  const std::vector<PinholeView> views = source.Views();
+  Eigen::MatrixXd sphere_V = V.topRows(base);
+  Eigen::MatrixXi sphere_F = F.topRows(sphere_faces);
+  const double footprint = MedianFootprint(views, sphere_V, VertexNormals(sphere_V, sphere_F));
+  EXPECT_NEAR(sphere_edge, options.target_edge_px * footprint,
+              0.35 * options.target_edge_px * footprint);
+}
+
 // Images without texture carry no information, also when they are not
 // exactly constant: a textureless region scaled by a non-dyadic factor holds
 // rounding noise of ~1e-7 (here a fixed pattern in each image). The flow must

@@ -93,15 +93,96 @@ std::vector<std::vector<int>> SelectNeighbors(const std::vector<PinholeView>& vi
   return neighbors;
 }
 
-// Median pixel footprint (world units per pixel) of the mesh vertices over
-// the views that see them (facing the camera, inside the image).
+EdgeSizing::EdgeSizing(std::vector<PinholeView> views, const Eigen::MatrixXd& V,
+                       const Eigen::MatrixXi& F, double edge_px, int max_faces)
+    : views_(std::move(views)) {
+  median_footprint_ = MedianFootprint(views_, V, VertexNormals(V, F));
+  if (!(median_footprint_ > 0)) return;
+  const Eigen::VectorXd areas = FaceAreas(V, F);
+  const Eigen::MatrixXd N = FaceNormals(V, F);
+  // The octaves in use: those between the 1st and the 99th percentile of the
+  // seen area (a few faces at the edge of a view's frustum do not add an
+  // octave to an object).
+  std::vector<int> octave(F.rows());
+  std::vector<std::pair<int, double>> seen;  // (octave, area)
+  double seen_area = 0;
+  for (int f = 0; f < F.rows(); ++f) {
+    const Eigen::Vector3d c = (V.row(F(f, 0)) + V.row(F(f, 1)) + V.row(F(f, 2))) / 3.0;
+    octave[f] = Octave(c, N.row(f));
+    if (octave[f] == kUnseen) continue;
+    seen.emplace_back(octave[f], areas(f));
+    seen_area += areas(f);
+  }
+  std::sort(seen.begin(), seen.end());
+  min_octave_ = max_octave_ = 0;  // when only vertices are seen
+  double below = 0;
+  bool found_min = false;
+  for (const auto& [k, area] : seen) {
+    below += area;
+    if (!found_min && below > 0.01 * seen_area) {
+      min_octave_ = k;
+      found_min = true;
+    }
+    if (below - area < 0.99 * seen_area) max_octave_ = k;
+  }
+  const int num_bands = max_octave_ - min_octave_ + 1;
+  // Faces per unit length^-2 of each octave's area; one octave sums the
+  // areas as the uniform remeshing always did.
+  std::vector<double> band_area(num_bands, 0.0);
+  if (num_bands == 1) {
+    band_area[0] = areas.sum();
+  } else {
+    for (int f = 0; f < F.rows(); ++f) {
+      const int k = octave[f] == kUnseen ? max_octave_ : octave[f];
+      band_area[std::clamp(k, min_octave_, max_octave_) - min_octave_] += areas(f);
+    }
+  }
+  // As the uniform remeshing always computed them: the edge of the median
+  // footprint, scaled up for the face budget; octaves are exact powers of 2.
+  const double equilateral = std::sqrt(3.0) / 4.0;
+  auto faces_at = [&](double edge) {
+    double faces = 0;
+    for (int b = 0; b < num_bands; ++b) {
+      const double band_edge = edge * std::ldexp(1.0, b + min_octave_);
+      faces += band_area[b] / (equilateral * band_edge * band_edge);
+    }
+    return faces;
+  };
+  double edge = edge_px * median_footprint_;
+  const double faces = faces_at(edge);
+  if (faces > max_faces) edge *= std::sqrt(faces / max_faces);
+  edge_px_ = edge / median_footprint_;
+  expected_faces_ = static_cast<int>(std::min<double>(faces_at(edge), max_faces));
+  for (int b = 0; b < num_bands; ++b) band_edges_.push_back(edge * std::ldexp(1.0, b + min_octave_));
+}
+
+int EdgeSizing::Octave(const Eigen::Vector3d& x, const Eigen::Vector3d& n) const {
+  std::vector<double> footprints;
+  footprints.reserve(views_.size());
+  for (const PinholeView& view : views_) {
+    const Eigen::Vector3d xc = view.WorldToCamera(x);
+    if (xc.z() <= 0 || n.dot(view.Center() - x) <= 0) continue;
+    if (!view.InImage(view.CameraToImage(xc))) continue;
+    footprints.push_back(xc.z() / view.fx);
+  }
+  if (footprints.empty()) return kUnseen;
+  std::nth_element(footprints.begin(), footprints.begin() + footprints.size() / 2,
+                   footprints.end());
+  constexpr int kMaxOctaves = 10;  // a factor of 1000 either way
+  const double octave = std::round(std::log2(footprints[footprints.size() / 2] / median_footprint_));
+  return static_cast<int>(std::clamp(octave, -double(kMaxOctaves), double(kMaxOctaves)));
+}
+
+int EdgeSizing::BandOf(const Eigen::Vector3d& x, const Eigen::Vector3d& n) const {
+  const int octave = Octave(x, n);
+  return std::clamp(octave == kUnseen ? max_octave_ : octave, min_octave_, max_octave_) -
+         min_octave_;
+}
+
 int RemeshedFaceCount(const std::vector<PinholeView>& views, const Eigen::MatrixXd& V,
                       const Eigen::MatrixXi& F, double edge_px, int max_faces) {
-  const double footprint = MedianFootprint(views, V, VertexNormals(V, F));
-  if (!(footprint > 0)) return 0;
-  const double edge = edge_px * footprint;
-  const double faces = FaceAreas(V, F).sum() / (std::sqrt(3.0) / 4.0 * edge * edge);
-  return static_cast<int>(std::min<double>(faces, max_faces));
+  const EdgeSizing sizing(views, V, F, edge_px, max_faces);
+  return sizing.visible() ? sizing.expected_faces() : 0;
 }
 
 double MedianFootprint(const std::vector<PinholeView>& views, const Eigen::MatrixXd& V,

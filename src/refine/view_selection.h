@@ -66,10 +66,55 @@ double MedianFootprint(const std::vector<PinholeView>& views, const Eigen::Matri
 double BestViewCoverage(const std::vector<PinholeView>& views, const Eigen::MatrixXd& V,
                         const Eigen::MatrixXi& F);
 
-// Faces of an isotropic mesh of the surface (V, F) with edges of `edge_px`
-// median pixel footprints in `views` (area / (sqrt(3)/4 e^2)), at most
-// `max_faces`: what remeshing for a pyramid level gives. 0 if no view sees
-// the surface.
+// The edge lengths a pyramid level remeshes the surface (V, F) to: `edge_px`
+// pixel footprints where the footprint varies across the surface, as in a
+// scene that recedes in depth (a table under an object, a street), not only
+// for an object seen from around.
+//
+// A point's footprint is the median of depth / focal length over the views
+// that see it (in front, facing it, inside the image; occlusion is not
+// tested). Edge lengths come in octaves of the whole mesh's median footprint
+// m (MedianFootprint): a point whose footprint is within a factor sqrt(2)
+// of m gets edge_px x m, one near 2m gets twice that, and so on, over the
+// octaves between the 1st and the 99th percentile of the seen area (points
+// beyond take the nearest); a point that no view sees gets the longest
+// length. An object seen from around lies within the first octave and gets
+// one length. When the expected
+// face count (area / (sqrt(3)/4 e^2) summed over the octaves) exceeds
+// `max_faces`, every length is scaled up to meet it.
+class EdgeSizing {
+ public:
+  EdgeSizing(std::vector<PinholeView> views, const Eigen::MatrixXd& V, const Eigen::MatrixXi& F,
+             double edge_px, int max_faces);
+  // Whether any view sees the surface (otherwise nothing else is set).
+  bool visible() const { return median_footprint_ > 0; }
+  double median_footprint() const { return median_footprint_; }
+  // The edge in pixels of the median footprint after the face budget.
+  double edge_px() const { return edge_px_; }
+  // The lengths of the octaves in use, shortest first (one when uniform).
+  const std::vector<double>& band_edges() const { return band_edges_; }
+  bool uniform() const { return band_edges_.size() == 1; }
+  // The octave of a point with unit normal n, as an index into band_edges().
+  int BandOf(const Eigen::Vector3d& x, const Eigen::Vector3d& n) const;
+  // Faces of an isotropic mesh with these lengths, at most max_faces.
+  int expected_faces() const { return expected_faces_; }
+
+ private:
+  // The octave (log2 of the footprint over the median, rounded), or
+  // kUnseen.
+  int Octave(const Eigen::Vector3d& x, const Eigen::Vector3d& n) const;
+  static constexpr int kUnseen = 1 << 20;
+  std::vector<PinholeView> views_;
+  double median_footprint_ = 0;
+  double edge_px_ = 0;
+  int min_octave_ = 0;
+  int max_octave_ = 0;
+  std::vector<double> band_edges_;
+  int expected_faces_ = 0;
+};
+
+// EdgeSizing(...).expected_faces(): what remeshing for a pyramid level gives.
+// 0 if no view sees the surface.
 int RemeshedFaceCount(const std::vector<PinholeView>& views, const Eigen::MatrixXd& V,
                       const Eigen::MatrixXi& F, double edge_px, int max_faces);
 

@@ -13,6 +13,9 @@
 
 #include <Eigen/Core>
 
+#include "geometry/mesh.h"
+#include "geometry/primitives.h"
+
 namespace mr {
 namespace {
 
@@ -144,6 +147,93 @@ TEST(SplitPairsCoveringViews, TwoHalvesEachCoverEveryView) {
   const auto none = SplitPairsCoveringViews({}, 3);
   ASSERT_EQ(none.size(), 3u);
   EXPECT_TRUE(none[0].empty() && none[1].empty() && none[2].empty());
+}
+
+// A square of half-side `half` at depth z, facing the origin (-z), as a grid
+// of n x n cells appended to (V, F).
+void AppendSquareFacingOrigin(double half, double z, int n, Eigen::MatrixXd* V,
+                              Eigen::MatrixXi* F) {
+  const int base = static_cast<int>(V->rows()), first_face = static_cast<int>(F->rows());
+  V->conservativeResize(base + (n + 1) * (n + 1), 3);
+  F->conservativeResize(first_face + 2 * n * n, 3);
+  for (int i = 0; i <= n; ++i) {
+    for (int j = 0; j <= n; ++j) {
+      V->row(base + i * (n + 1) + j) << -half + 2 * half * j / n, -half + 2 * half * i / n, z;
+    }
+  }
+  int f = first_face;
+  for (int i = 0; i < n; ++i) {
+    for (int j = 0; j < n; ++j) {
+      const int a = base + i * (n + 1) + j, b = a + 1, c = a + n + 1, d = c + 1;
+      F->row(f++) << a, d, b;  // normal -z, towards the camera at the origin
+      F->row(f++) << a, c, d;
+    }
+  }
+}
+
+// Two squares at depths 10 and 40 that fill the same part of one image: the
+// near one gets edges a quarter as long (two octaves apart), and the face
+// count is summed over them.
+TEST(EdgeSizing, SurfacesInDepthGetOctaves) {
+  const std::vector<PinholeView> views = {LookAtView(Eigen::Vector3d::Zero(),
+                                                     Eigen::Vector3d(0, 0, 1),
+                                                     Eigen::Vector3d(0, -1, 0), 640, 480, 500)};
+  Eigen::MatrixXd V(0, 3);
+  Eigen::MatrixXi F(0, 3);
+  AppendSquareFacingOrigin(1, 10, 10, &V, &F);
+  AppendSquareFacingOrigin(4, 40, 10, &V, &F);
+  const double edge_px = 2.5;
+  const EdgeSizing sizing(views, V, F, edge_px, 1000000);
+  ASSERT_TRUE(sizing.visible());
+  // Equal vertex counts: the median is the far footprint, 40 / 500.
+  EXPECT_DOUBLE_EQ(sizing.median_footprint(), 40.0 / 500);
+  EXPECT_FALSE(sizing.uniform());
+  ASSERT_EQ(sizing.band_edges().size(), 3u);  // octaves -2, -1 (empty), 0
+  EXPECT_DOUBLE_EQ(sizing.band_edges()[0], edge_px * 10.0 / 500);
+  EXPECT_DOUBLE_EQ(sizing.band_edges()[2], edge_px * 40.0 / 500);
+  const Eigen::Vector3d towards_camera(0, 0, -1);
+  EXPECT_EQ(sizing.BandOf(Eigen::Vector3d(0.3, 0.2, 10), towards_camera), 0);
+  EXPECT_EQ(sizing.BandOf(Eigen::Vector3d(1.2, -0.8, 40), towards_camera), 2);
+  EXPECT_EQ(sizing.BandOf(Eigen::Vector3d(0, 0, 20), towards_camera), 1);
+  // Unseen (facing away, or outside the image): the longest edges.
+  EXPECT_EQ(sizing.BandOf(Eigen::Vector3d(0.3, 0.2, 10), -towards_camera), 2);
+  EXPECT_EQ(sizing.BandOf(Eigen::Vector3d(500, 0, 10), towards_camera), 2);
+  const double equilateral = std::sqrt(3.0) / 4;
+  const double e0 = sizing.band_edges()[0], e2 = sizing.band_edges()[2];
+  const double faces = 4.0 / (equilateral * e0 * e0) + 64.0 / (equilateral * e2 * e2);
+  EXPECT_NEAR(sizing.expected_faces(), faces, 1.0);
+  EXPECT_EQ(RemeshedFaceCount(views, V, F, edge_px, 1000000), sizing.expected_faces());
+  EXPECT_DOUBLE_EQ(sizing.edge_px(), edge_px);
+  // A face budget scales every length alike.
+  const EdgeSizing budget(views, V, F, edge_px, 1000);
+  EXPECT_NEAR(budget.expected_faces(), 1000, 1);  // truncated after the scaling
+  EXPECT_NEAR(budget.band_edges()[2] / budget.band_edges()[0], 4.0, 1e-12);
+  EXPECT_NEAR(budget.edge_px(), edge_px * std::sqrt(faces / 1000), 1e-9);
+}
+
+// An object seen from around lies within one octave: one length, the median
+// footprint's, as the uniform remeshing always had.
+TEST(EdgeSizing, ObjectSeenFromAroundIsUniform) {
+  Eigen::MatrixXd V;
+  Eigen::MatrixXi F;
+  MakeIcosphere(3, 1.0, &V, &F);
+  std::vector<PinholeView> views;
+  for (int i = 0; i < 12; ++i) {
+    const double a = 2 * M_PI * i / 12;
+    views.push_back(LookAtView(Eigen::Vector3d(4 * std::cos(a), 4 * std::sin(a), 2),
+                               Eigen::Vector3d::Zero(), Eigen::Vector3d(0, 0, 1), 640, 480, 500));
+  }
+  const EdgeSizing sizing(views, V, F, 2.5, 1000000);
+  ASSERT_TRUE(sizing.visible());
+  EXPECT_TRUE(sizing.uniform());
+  EXPECT_DOUBLE_EQ(sizing.band_edges()[0],
+                   2.5 * MedianFootprint(views, V, VertexNormals(V, F)));
+  // Not seen at all.
+  const std::vector<PinholeView> away = {LookAtView(Eigen::Vector3d(10, 0, 0),
+                                                    Eigen::Vector3d(20, 0, 0),
+                                                    Eigen::Vector3d(0, 0, 1), 640, 480, 500)};
+  EXPECT_FALSE(EdgeSizing(away, V, F, 2.5, 1000000).visible());
+  EXPECT_EQ(RemeshedFaceCount(away, V, F, 2.5, 1000000), 0);
 }
 
 }  // namespace
