@@ -19,10 +19,12 @@ struct ObservedEvaluation {
 };
 
 // Evaluates `dense`/meshed-poisson.ply and `dense`/meshed-refined.ply against
-// `gt_path` on the observed surface.
+// `gt_path` on the observed surface (within `region`, if given, as
+// mesh_evaluator --region_box).
 inline ObservedEvaluation EvaluateObservedSurface(const std::string& dense,
                                                   const std::string& gt_path,
-                                                  const EvaluationOptions& options) {
+                                                  const EvaluationOptions& options,
+                                                  const RegionBox* region = nullptr) {
   const TriangleMesh gt = ReadPly(gt_path);
   const TriangleMesh before = ReadPly(dense + "/meshed-poisson.ply");
   const TriangleMesh after = ReadPly(dense + "/meshed-refined.ply");
@@ -32,7 +34,8 @@ inline ObservedEvaluation EvaluateObservedSurface(const std::string& dense,
     const Image& image = workspace.model.images.at(id);
     views.push_back(ViewFromColmap(workspace.model.cameras.at(image.camera_id), image));
   }
-  const std::vector<char> observed = ObservedFaces(gt.V, gt.F, views, 2);
+  std::vector<char> observed = ObservedFaces(gt.V, gt.F, views, 2);
+  if (region != nullptr) KeepFacesInBox(gt.V, gt.F, *region, &observed);
   ObservedEvaluation result;
   result.input = EvaluateMesh(before.V, before.F, gt.V, gt.F, options, &observed);
   result.refined = EvaluateMesh(after.V, after.F, gt.V, gt.F, options, &observed);

@@ -15,5 +15,15 @@ mkdir -p "$OUT"
 case_flags() {
   local line
   line=$(grep -E "^$1\s*\|" "$CORPUS") || { echo "unknown case: $1" >&2; exit 2; }
-  echo "${line#*|}" | sed "s#--model_path #--model_path $MODELS/#"
+  line=${line#*|}
+  echo "${line%%|*}" | sed "s#--model_path #--model_path $MODELS/#"
+}
+
+# case_eval_flags NAME: the case's mesh_evaluator flags (corpus.txt's optional
+# third field), e.g. a --region_box.
+case_eval_flags() {
+  local line
+  line=$(grep -E "^$1\s*\|" "$CORPUS") || { echo "unknown case: $1" >&2; exit 2; }
+  line=${line#*|}
+  case "$line" in *"|"*) echo "${line#*|}" ;; esac
 }

@@ -34,8 +34,9 @@ cases=$(grep -v '^#' "$CORPUS" | grep -v '^\s*$' | cut -d'|' -f1 | tr -d ' ')
 if [ $# -gt 0 ]; then cases="$*"; fi
 
 evaluate() {  # case mesh -> json on stdout
+  # shellcheck disable=SC2046
   "$BIN/mesh_evaluator" --input_path "$2" --gt_path "$OUT/$1/ground_truth.ply" \
-    --workspace_path "$OUT/$1/dense"
+    --workspace_path "$OUT/$1/dense" $(case_eval_flags "$1")
 }
 
 TSV="$OUT/results.tsv"

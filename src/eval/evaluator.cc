@@ -4,6 +4,8 @@
 #include <cmath>
 #include <cstdint>
 #include <cstdio>
+#include <sstream>
+#include <string>
 #include <vector>
 
 #include <CGAL/AABB_traits.h>
@@ -335,6 +337,33 @@ std::vector<char> ObservedFaces(const Eigen::MatrixXd& V, const Eigen::MatrixXi&
   std::vector<char> observed(F.rows());
   for (int f = 0; f < F.rows(); ++f) observed[f] = count[f] >= min_views ? 1 : 0;
   return observed;
+}
+
+RegionBox RegionBox::Parse(const std::string& text) {
+  std::string numbers = text;
+  std::replace(numbers.begin(), numbers.end(), ',', ' ');
+  std::istringstream in(numbers);
+  RegionBox box;
+  if (!(in >> box.lo.x() >> box.lo.y() >> box.lo.z() >> box.hi.x() >> box.hi.y() >> box.hi.z()) ||
+      !(in >> std::ws).eof() || !(box.lo.array() < box.hi.array()).all()) {
+    MR_THROW_INPUT << "region box \"" << text
+                   << "\": expected six numbers \"x0 y0 z0 x1 y1 z1\" with x0 < x1, y0 < y1, "
+                      "z0 < z1";
+  }
+  return box;
+}
+
+long KeepFacesInBox(const Eigen::MatrixXd& V, const Eigen::MatrixXi& F, const RegionBox& box,
+                    std::vector<char>* flags) {
+  if (flags->empty()) flags->assign(F.rows(), 1);
+  MR_CHECK_EQ(static_cast<long>(flags->size()), static_cast<long>(F.rows()));
+  long kept = 0;
+  for (int f = 0; f < F.rows(); ++f) {
+    const Eigen::Vector3d c = (V.row(F(f, 0)) + V.row(F(f, 1)) + V.row(F(f, 2))) / 3.0;
+    if (!box.Contains(c)) (*flags)[f] = 0;
+    kept += (*flags)[f] != 0;
+  }
+  return kept;
 }
 
 }  // namespace mr

@@ -79,4 +79,23 @@ SurfaceDisplacement MeasureSurfaceDisplacement(const Eigen::MatrixXd& V,
 std::vector<char> ObservedFaces(const Eigen::MatrixXd& V, const Eigen::MatrixXi& F,
                                 const std::vector<PinholeView>& views, int min_views);
 
+// An axis-aligned box of scene space, for a region of interest.
+struct RegionBox {
+  Eigen::Vector3d lo = Eigen::Vector3d::Zero();
+  Eigen::Vector3d hi = Eigen::Vector3d::Zero();
+  // "x0 y0 z0 x1 y1 z1" (spaces or commas), x0 < x1, y0 < y1, z0 < z1;
+  // throws InputError naming `text` otherwise.
+  static RegionBox Parse(const std::string& text);
+  bool Contains(const Eigen::Vector3d& x) const {
+    return (x.array() >= lo.array()).all() && (x.array() <= hi.array()).all();
+  }
+};
+
+// Clears the flag of every face of (V, F) whose centroid lies outside `box`
+// (first flagging every face when `flags` is empty): the faces a region of
+// interest keeps, e.g. as EvaluateMesh's `gt_observed`. Returns how many
+// stay flagged.
+long KeepFacesInBox(const Eigen::MatrixXd& V, const Eigen::MatrixXi& F, const RegionBox& box,
+                    std::vector<char>* flags);
+
 }  // namespace mr

@@ -6,7 +6,6 @@
 //       [--workspace_path dense/] [--sparse_path dense/sparse_refined
 //        --true_sparse_path sparse_true [--align_cameras 1]]
 
-#include <algorithm>
 #include <cmath>
 #include <exception>
 #include <sstream>
@@ -121,26 +120,8 @@ int main(int argc, char** argv) {
       observed = mr::ObservedFaces(gt.V, gt.F, views, min_views);
     }
     if (!region_box.empty()) {
-      std::string numbers = region_box;
-      std::replace(numbers.begin(), numbers.end(), ',', ' ');
-      std::istringstream in(numbers);
-      Eigen::Vector3d lo, hi;
-      if (!(in >> lo.x() >> lo.y() >> lo.z() >> hi.x() >> hi.y() >> hi.z()) ||
-          !(in >> std::ws).eof() || !(lo.array() < hi.array()).all()) {
-        MR_THROW_INPUT << "--region_box \"" << region_box
-                       << "\": expected six numbers \"x0 y0 z0 x1 y1 z1\" with x0 < x1, y0 < y1, "
-                          "z0 < z1";
-      }
-      if (observed.empty()) observed.assign(gt.F.rows(), 1);
-      long inside = 0;
-      for (int f = 0; f < gt.F.rows(); ++f) {
-        const Eigen::Vector3d c =
-            (gt.V.row(gt.F(f, 0)) + gt.V.row(gt.F(f, 1)) + gt.V.row(gt.F(f, 2))) / 3.0;
-        const bool in_box = (c.array() >= lo.array()).all() && (c.array() <= hi.array()).all();
-        if (!in_box) observed[f] = 0;
-        inside += observed[f] != 0;
-      }
-      if (inside == 0) {
+      const mr::RegionBox box = mr::RegionBox::Parse(region_box);
+      if (mr::KeepFacesInBox(gt.V, gt.F, box, &observed) == 0) {
         MR_THROW_INPUT << "--region_box \"" << region_box
                        << "\": no (observed) ground-truth face has its centroid in the box";
       }
