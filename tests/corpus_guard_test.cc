@@ -104,14 +104,15 @@ TEST_P(CorpusGuard, DefaultsImproveTheObservedSurface) {
 // Bounds: the ratios measured with the defaults on the full corpus run
 // (rocker-head-noise 0.358 / 0.686, bunny-color-hemi 0.422 / 0.760,
 // cheburashka-head 0.318 / 0.651; docs/results.md, after the silhouette
-// correction; builtin-ground, a scene in depth, 0.227 / 0.415, where one
-// edge length for the whole scene gave 0.302 / 0.549), plus 0.05 for
-// run-to-run and machine differences.
+// correction; builtin-ground, a scene in depth, 0.256 / 0.481, where one
+// edge length for the whole scene gave 0.302 / 0.549: the normal bound
+// catches that, the accuracy bound does not), plus 0.05 for run-to-run and
+// machine differences.
 INSTANTIATE_TEST_SUITE_P(Corpus, CorpusGuard,
                          ::testing::Values(GuardCase{"rocker-head-noise", 0.41, 0.74},
                                            GuardCase{"bunny-color-hemi", 0.47, 0.81},
                                            GuardCase{"cheburashka-head", 0.37, 0.70},
-                                           GuardCase{"builtin-ground", 0.28, 0.47}),
+                                           GuardCase{"builtin-ground", 0.31, 0.53}),
                          [](const ::testing::TestParamInfo<GuardCase>& info) {
                            std::string name = info.param.name;
                            for (char& ch : name) {

@@ -164,7 +164,7 @@ void PrintSummary(const Workspace& workspace, const ViewSource& source, const Tr
               sizing.visible() ? sizing.edge_px() : refine.target_edge_px,
               sizing.uniform() ? ""
                                : (" in " + std::to_string(sizing.band_edges().size()) +
-                                  " octaves of depth")
+                                  " depth bands")
                                      .c_str(),
               max_faces);
 }

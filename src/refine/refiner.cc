@@ -178,7 +178,7 @@ bool RemeshForLevel(const std::vector<PinholeView>& views, const RefineOptions& 
   std::ostringstream edges;
   if (!sizing.uniform()) {
     edges << " of each point's median footprint: " << sizing.band_edges().size()
-          << " octaves, " << sizing.band_edges().front() << " to " << sizing.band_edges().back()
+          << " depth bands a factor sqrt(2) apart, " << sizing.band_edges().front() << " to " << sizing.band_edges().back()
           << " scene units";
   }
   MR_LOG(INFO) << "Remeshed " << faces_before << " -> " << F->rows() << " faces (edge "

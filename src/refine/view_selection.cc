@@ -93,6 +93,29 @@ std::vector<std::vector<int>> SelectNeighbors(const std::vector<PinholeView>& vi
   return neighbors;
 }
 
+namespace {
+
+// Appends the pixel footprint (depth / fx) of point x (normal n) in each of
+// `views` that sees it: in front, facing it, inside the image.
+void AppendFootprints(const std::vector<PinholeView>& views, const Eigen::Vector3d& x,
+                      const Eigen::Vector3d& n, std::vector<double>* footprints) {
+  for (const PinholeView& view : views) {
+    const Eigen::Vector3d xc = view.WorldToCamera(x);
+    if (xc.z() <= 0 || n.dot(view.Center() - x) <= 0) continue;
+    if (!view.InImage(view.CameraToImage(xc))) continue;
+    footprints->push_back(xc.z() / view.fx);
+  }
+}
+
+// The element at size / 2 of the sorted values (reorders them); 0 if none.
+double UpperMedian(std::vector<double>* values) {
+  if (values->empty()) return 0;
+  std::nth_element(values->begin(), values->begin() + values->size() / 2, values->end());
+  return (*values)[values->size() / 2];
+}
+
+}  // namespace
+
 EdgeSizing::EdgeSizing(std::vector<PinholeView> views, const Eigen::MatrixXd& V,
                        const Eigen::MatrixXi& F, double edge_px, int max_faces)
     : views_(std::move(views)) {
@@ -100,83 +123,116 @@ EdgeSizing::EdgeSizing(std::vector<PinholeView> views, const Eigen::MatrixXd& V,
   if (!(median_footprint_ > 0)) return;
   const Eigen::VectorXd areas = FaceAreas(V, F);
   const Eigen::MatrixXd N = FaceNormals(V, F);
-  // The octaves in use: those between the 1st and the 99th percentile of the
-  // seen area (a few faces at the edge of a view's frustum do not add an
-  // octave to an object).
-  std::vector<int> octave(F.rows());
-  std::vector<std::pair<int, double>> seen;  // (octave, area)
-  double seen_area = 0;
+  // Each face's footprint. The bands are centred on the footprint that the
+  // most area shares (within half an octave: e.g. the object, where a ground
+  // recedes behind it), so that it gets its own length exactly: the
+  // area-weighted median of log2(footprint / m) in the half-octave window
+  // that holds the most area.
+  std::vector<double> footprint(F.rows());
+  std::vector<std::pair<double, double>> logs;  // (log2(footprint / m), area)
   for (int f = 0; f < F.rows(); ++f) {
     const Eigen::Vector3d c = (V.row(F(f, 0)) + V.row(F(f, 1)) + V.row(F(f, 2))) / 3.0;
-    octave[f] = Octave(c, N.row(f));
-    if (octave[f] == kUnseen) continue;
-    seen.emplace_back(octave[f], areas(f));
+    footprint[f] = Footprint(c, N.row(f));
+    if (footprint[f] > 0) logs.emplace_back(std::log2(footprint[f] / median_footprint_), areas(f));
+  }
+  std::sort(logs.begin(), logs.end());
+  size_t best_begin = 0, best_end = 0;
+  double best_area = -1, window_area = 0;
+  for (size_t begin = 0, end = 0; begin < logs.size(); ++begin) {
+    for (; end < logs.size() && logs[end].first <= logs[begin].first + kBandWidth; ++end) {
+      window_area += logs[end].second;
+    }
+    if (window_area > best_area) {
+      best_area = window_area;
+      best_begin = begin;
+      best_end = end;
+    }
+    window_area -= logs[begin].second;
+  }
+  anchor_ = 0;
+  double sum = 0;
+  for (size_t i = best_begin; i < best_end; ++i) {
+    sum += logs[i].second;
+    if (sum >= 0.5 * best_area) {
+      anchor_ = logs[i].first;
+      break;
+    }
+  }
+  // Each face's band; those in use lie between the 1st and the 99th
+  // percentile of the seen area (a few faces at the edge of a view's
+  // frustum do not add a band to an object).
+  std::vector<int> step(F.rows(), kUnseen);
+  std::vector<std::pair<int, double>> seen;  // (band step, area)
+  double seen_area = 0;
+  for (int f = 0; f < F.rows(); ++f) {
+    if (!(footprint[f] > 0)) continue;
+    step[f] = HalfOctaveOf(footprint[f]);
+    seen.emplace_back(step[f], areas(f));
     seen_area += areas(f);
   }
   std::sort(seen.begin(), seen.end());
-  min_octave_ = max_octave_ = 0;  // when only vertices are seen
+  min_step_ = max_step_ = 0;  // when only vertices are seen
   double below = 0;
   bool found_min = false;
   for (const auto& [k, area] : seen) {
     below += area;
     if (!found_min && below > 0.01 * seen_area) {
-      min_octave_ = k;
+      min_step_ = k;
       found_min = true;
     }
-    if (below - area < 0.99 * seen_area) max_octave_ = k;
+    if (below - area < 0.99 * seen_area) max_step_ = k;
   }
-  const int num_bands = max_octave_ - min_octave_ + 1;
-  // Faces per unit length^-2 of each octave's area; one octave sums the
-  // areas as the uniform remeshing always did.
+  const int num_bands = max_step_ - min_step_ + 1;
+  // Each band's area and footprint: m x 2^(anchor + k/2) for band k (one
+  // band: m and the whole area, as the uniform remeshing always had).
   std::vector<double> band_area(num_bands, 0.0);
+  std::vector<double> band_footprint(num_bands, median_footprint_);
   if (num_bands == 1) {
     band_area[0] = areas.sum();
   } else {
     for (int f = 0; f < F.rows(); ++f) {
-      const int k = octave[f] == kUnseen ? max_octave_ : octave[f];
-      band_area[std::clamp(k, min_octave_, max_octave_) - min_octave_] += areas(f);
+      const int k = step[f] == kUnseen ? max_step_ : step[f];
+      band_area[std::clamp(k, min_step_, max_step_) - min_step_] += areas(f);
+    }
+    for (int b = 0; b < num_bands; ++b) {
+      band_footprint[b] = median_footprint_ * std::exp2(anchor_ + kBandWidth * (b + min_step_));
     }
   }
-  // As the uniform remeshing always computed them: the edge of the median
-  // footprint, scaled up for the face budget; octaves are exact powers of 2.
   const double equilateral = std::sqrt(3.0) / 4.0;
-  auto faces_at = [&](double edge) {
+  for (int b = 0; b < num_bands; ++b) band_edges_.push_back(edge_px * band_footprint[b]);
+  auto expected = [&] {
     double faces = 0;
     for (int b = 0; b < num_bands; ++b) {
-      const double band_edge = edge * std::ldexp(1.0, b + min_octave_);
-      faces += band_area[b] / (equilateral * band_edge * band_edge);
+      faces += band_area[b] / (equilateral * band_edges_[b] * band_edges_[b]);
     }
     return faces;
   };
-  double edge = edge_px * median_footprint_;
-  const double faces = faces_at(edge);
-  if (faces > max_faces) edge *= std::sqrt(faces / max_faces);
-  edge_px_ = edge / median_footprint_;
-  expected_faces_ = static_cast<int>(std::min<double>(faces_at(edge), max_faces));
-  for (int b = 0; b < num_bands; ++b) band_edges_.push_back(edge * std::ldexp(1.0, b + min_octave_));
+  // The face budget lengthens every band alike.
+  const double faces = expected();
+  if (faces > max_faces) {
+    for (double& edge : band_edges_) edge *= std::sqrt(faces / max_faces);
+  }
+  edge_px_ = band_edges_[0] / band_footprint[0];
+  expected_faces_ = static_cast<int>(std::min<double>(expected(), max_faces));
 }
 
-int EdgeSizing::Octave(const Eigen::Vector3d& x, const Eigen::Vector3d& n) const {
+double EdgeSizing::Footprint(const Eigen::Vector3d& x, const Eigen::Vector3d& n) const {
   std::vector<double> footprints;
   footprints.reserve(views_.size());
-  for (const PinholeView& view : views_) {
-    const Eigen::Vector3d xc = view.WorldToCamera(x);
-    if (xc.z() <= 0 || n.dot(view.Center() - x) <= 0) continue;
-    if (!view.InImage(view.CameraToImage(xc))) continue;
-    footprints.push_back(xc.z() / view.fx);
-  }
-  if (footprints.empty()) return kUnseen;
-  std::nth_element(footprints.begin(), footprints.begin() + footprints.size() / 2,
-                   footprints.end());
-  constexpr int kMaxOctaves = 10;  // a factor of 1000 either way
-  const double octave = std::round(std::log2(footprints[footprints.size() / 2] / median_footprint_));
-  return static_cast<int>(std::clamp(octave, -double(kMaxOctaves), double(kMaxOctaves)));
+  AppendFootprints(views_, x, n, &footprints);
+  return UpperMedian(&footprints);
+}
+
+int EdgeSizing::HalfOctaveOf(double footprint) const {
+  constexpr int kMaxSteps = 20;  // a factor of 1000 either way
+  const double steps = std::round((std::log2(footprint / median_footprint_) - anchor_) / kBandWidth);
+  return static_cast<int>(std::clamp(steps, -double(kMaxSteps), double(kMaxSteps)));
 }
 
 int EdgeSizing::BandOf(const Eigen::Vector3d& x, const Eigen::Vector3d& n) const {
-  const int octave = Octave(x, n);
-  return std::clamp(octave == kUnseen ? max_octave_ : octave, min_octave_, max_octave_) -
-         min_octave_;
+  const double footprint = Footprint(x, n);
+  const int k = footprint > 0 ? HalfOctaveOf(footprint) : max_step_;
+  return std::clamp(k, min_step_, max_step_) - min_step_;
 }
 
 int RemeshedFaceCount(const std::vector<PinholeView>& views, const Eigen::MatrixXd& V,
@@ -189,19 +245,8 @@ double MedianFootprint(const std::vector<PinholeView>& views, const Eigen::Matri
                        const Eigen::MatrixXd& N) {
   std::vector<double> footprints;
   const int stride = std::max<int>(1, static_cast<int>(V.rows() / 5000));
-  for (int v = 0; v < V.rows(); v += stride) {
-    const Eigen::Vector3d x = V.row(v);
-    for (const auto& view : views) {
-      const Eigen::Vector3d xc = view.WorldToCamera(x);
-      if (xc.z() <= 0 || N.row(v).dot(view.Center() - x) <= 0) continue;
-      if (!view.InImage(view.CameraToImage(xc))) continue;
-      footprints.push_back(xc.z() / view.fx);
-    }
-  }
-  if (footprints.empty()) return 0;
-  std::nth_element(footprints.begin(), footprints.begin() + footprints.size() / 2,
-                   footprints.end());
-  return footprints[footprints.size() / 2];
+  for (int v = 0; v < V.rows(); v += stride) AppendFootprints(views, V.row(v), N.row(v), &footprints);
+  return UpperMedian(&footprints);
 }
 
 double BestViewCoverage(const std::vector<PinholeView>& views, const Eigen::MatrixXd& V,

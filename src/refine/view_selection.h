@@ -73,15 +73,19 @@ double BestViewCoverage(const std::vector<PinholeView>& views, const Eigen::Matr
 //
 // A point's footprint is the median of depth / focal length over the views
 // that see it (in front, facing it, inside the image; occlusion is not
-// tested). Edge lengths come in octaves of the whole mesh's median footprint
-// m (MedianFootprint): a point whose footprint is within a factor sqrt(2)
-// of m gets edge_px x m, one near 2m gets twice that, and so on, over the
-// octaves between the 1st and the 99th percentile of the seen area (points
-// beyond take the nearest); a point that no view sees gets the longest
-// length. An object seen from around lies within the first octave and gets
-// one length. When the expected
-// face count (area / (sqrt(3)/4 e^2) summed over the octaves) exceeds
-// `max_faces`, every length is scaled up to meet it.
+// tested). The surface is divided into bands half an octave wide, centred on
+// the footprint that the most area shares (the area-weighted median footprint
+// in the half-octave window that holds the most area, f0: e.g. the object's,
+// where a ground recedes behind it): the points within a factor 2^(1/4) of
+// f0, those near sqrt(2) f0, 2 f0, and so on, over the bands between the 1st
+// and the 99th percentile of the seen area (points beyond take the nearest);
+// a point that no view sees takes the farthest. Band k gets edges of edge_px
+// x f0 x 2^(k/2), at most 19 % off each point's own footprint. An object
+// seen from around mostly lies within one band and gets one length, edge_px
+// x m with m the whole mesh's median footprint (MedianFootprint), as the
+// uniform remeshing always had. When the expected face count (area /
+// (sqrt(3)/4 e^2) summed over the bands) exceeds `max_faces`, every length is
+// scaled up alike to meet it.
 class EdgeSizing {
  public:
   EdgeSizing(std::vector<PinholeView> views, const Eigen::MatrixXd& V, const Eigen::MatrixXi& F,
@@ -89,26 +93,30 @@ class EdgeSizing {
   // Whether any view sees the surface (otherwise nothing else is set).
   bool visible() const { return median_footprint_ > 0; }
   double median_footprint() const { return median_footprint_; }
-  // The edge in pixels of the median footprint after the face budget.
+  // The edge in pixels of each band's footprint, after the face budget.
   double edge_px() const { return edge_px_; }
-  // The lengths of the octaves in use, shortest first (one when uniform).
+  // The lengths of the bands in use, shortest first (one when uniform).
   const std::vector<double>& band_edges() const { return band_edges_; }
   bool uniform() const { return band_edges_.size() == 1; }
-  // The octave of a point with unit normal n, as an index into band_edges().
+  // The band of a point with unit normal n, as an index into band_edges().
   int BandOf(const Eigen::Vector3d& x, const Eigen::Vector3d& n) const;
   // Faces of an isotropic mesh with these lengths, at most max_faces.
   int expected_faces() const { return expected_faces_; }
 
  private:
-  // The octave (log2 of the footprint over the median, rounded), or
-  // kUnseen.
-  int Octave(const Eigen::Vector3d& x, const Eigen::Vector3d& n) const;
+  // The footprint at x (normal n), 0 where no view sees it.
+  double Footprint(const Eigen::Vector3d& x, const Eigen::Vector3d& n) const;
+  // 2 (log2(footprint / median footprint) - anchor), rounded: the band step.
+  int HalfOctaveOf(double footprint) const;
   static constexpr int kUnseen = 1 << 20;
+  // Width of a band, in octaves (log2 of the footprint).
+  static constexpr double kBandWidth = 0.5;
   std::vector<PinholeView> views_;
   double median_footprint_ = 0;
   double edge_px_ = 0;
-  int min_octave_ = 0;
-  int max_octave_ = 0;
+  double anchor_ = 0;  // log2 of the bands' centre footprint over the median
+  int min_step_ = 0;
+  int max_step_ = 0;
   std::vector<double> band_edges_;
   int expected_faces_ = 0;
 };

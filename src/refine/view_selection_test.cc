@@ -172,9 +172,9 @@ void AppendSquareFacingOrigin(double half, double z, int n, Eigen::MatrixXd* V,
 }
 
 // Two squares at depths 10 and 40 that fill the same part of one image: the
-// near one gets edges a quarter as long (two octaves apart), and the face
-// count is summed over them.
-TEST(EdgeSizing, SurfacesInDepthGetOctaves) {
+// near one gets edges a quarter as long (four half-octave bands apart), and
+// the face count is summed over them.
+TEST(EdgeSizing, SurfacesInDepthGetBands) {
   const std::vector<PinholeView> views = {LookAtView(Eigen::Vector3d::Zero(),
                                                      Eigen::Vector3d(0, 0, 1),
                                                      Eigen::Vector3d(0, -1, 0), 640, 480, 500)};
@@ -188,30 +188,32 @@ TEST(EdgeSizing, SurfacesInDepthGetOctaves) {
   // Equal vertex counts: the median is the far footprint, 40 / 500.
   EXPECT_DOUBLE_EQ(sizing.median_footprint(), 40.0 / 500);
   EXPECT_FALSE(sizing.uniform());
-  ASSERT_EQ(sizing.band_edges().size(), 3u);  // octaves -2, -1 (empty), 0
+  ASSERT_EQ(sizing.band_edges().size(), 5u);  // half-octaves -4 .. 0, the middle ones empty
   EXPECT_DOUBLE_EQ(sizing.band_edges()[0], edge_px * 10.0 / 500);
-  EXPECT_DOUBLE_EQ(sizing.band_edges()[2], edge_px * 40.0 / 500);
+  EXPECT_DOUBLE_EQ(sizing.band_edges()[2], edge_px * 20.0 / 500);
+  EXPECT_DOUBLE_EQ(sizing.band_edges()[4], edge_px * 40.0 / 500);
   const Eigen::Vector3d towards_camera(0, 0, -1);
   EXPECT_EQ(sizing.BandOf(Eigen::Vector3d(0.3, 0.2, 10), towards_camera), 0);
-  EXPECT_EQ(sizing.BandOf(Eigen::Vector3d(1.2, -0.8, 40), towards_camera), 2);
-  EXPECT_EQ(sizing.BandOf(Eigen::Vector3d(0, 0, 20), towards_camera), 1);
+  EXPECT_EQ(sizing.BandOf(Eigen::Vector3d(1.2, -0.8, 40), towards_camera), 4);
+  EXPECT_EQ(sizing.BandOf(Eigen::Vector3d(0, 0, 20), towards_camera), 2);
+  EXPECT_EQ(sizing.BandOf(Eigen::Vector3d(0, 0, 14), towards_camera), 1);  // 10 sqrt(2)
   // Unseen (facing away, or outside the image): the longest edges.
-  EXPECT_EQ(sizing.BandOf(Eigen::Vector3d(0.3, 0.2, 10), -towards_camera), 2);
-  EXPECT_EQ(sizing.BandOf(Eigen::Vector3d(500, 0, 10), towards_camera), 2);
+  EXPECT_EQ(sizing.BandOf(Eigen::Vector3d(0.3, 0.2, 10), -towards_camera), 4);
+  EXPECT_EQ(sizing.BandOf(Eigen::Vector3d(500, 0, 10), towards_camera), 4);
   const double equilateral = std::sqrt(3.0) / 4;
-  const double e0 = sizing.band_edges()[0], e2 = sizing.band_edges()[2];
-  const double faces = 4.0 / (equilateral * e0 * e0) + 64.0 / (equilateral * e2 * e2);
+  const double e0 = sizing.band_edges()[0], e4 = sizing.band_edges()[4];
+  const double faces = 4.0 / (equilateral * e0 * e0) + 64.0 / (equilateral * e4 * e4);
   EXPECT_NEAR(sizing.expected_faces(), faces, 1.0);
   EXPECT_EQ(RemeshedFaceCount(views, V, F, edge_px, 1000000), sizing.expected_faces());
   EXPECT_DOUBLE_EQ(sizing.edge_px(), edge_px);
   // A face budget scales every length alike.
   const EdgeSizing budget(views, V, F, edge_px, 1000);
   EXPECT_NEAR(budget.expected_faces(), 1000, 1);  // truncated after the scaling
-  EXPECT_NEAR(budget.band_edges()[2] / budget.band_edges()[0], 4.0, 1e-12);
+  EXPECT_NEAR(budget.band_edges()[4] / budget.band_edges()[0], 4.0, 1e-12);
   EXPECT_NEAR(budget.edge_px(), edge_px * std::sqrt(faces / 1000), 1e-9);
 }
 
-// An object seen from around lies within one octave: one length, the median
+// An object seen from around lies within one band: one length, the median
 // footprint's, as the uniform remeshing always had.
 TEST(EdgeSizing, ObjectSeenFromAroundIsUniform) {
   Eigen::MatrixXd V;
