@@ -53,4 +53,25 @@ void MakeIcosphere(int subdivisions, double radius, const Eigen::Vector3d& cente
   V->rowwise() += center.transpose();
 }
 
+void AppendGrid(const Eigen::Vector3d& origin, const Eigen::Vector3d& u, const Eigen::Vector3d& v,
+                int cells, Eigen::MatrixXd* V, Eigen::MatrixXi* F) {
+  const int base = static_cast<int>(V->rows()), first_face = static_cast<int>(F->rows());
+  const int n = cells + 1;
+  V->conservativeResize(base + n * n, 3);
+  F->conservativeResize(first_face + 2 * cells * cells, 3);
+  for (int i = 0; i < n; ++i) {
+    for (int j = 0; j < n; ++j) {
+      V->row(base + i * n + j) = (origin + (u * j) / cells + (v * i) / cells).transpose();
+    }
+  }
+  int f = first_face;
+  for (int i = 0; i < cells; ++i) {
+    for (int j = 0; j < cells; ++j) {
+      const int a = base + i * n + j, b = a + 1, c = a + n, d = c + 1;
+      F->row(f++) << a, b, d;
+      F->row(f++) << a, d, c;
+    }
+  }
+}
+
 }  // namespace mr

@@ -330,20 +330,9 @@ TEST_F(RefinerTest, EdgesFollowTheFootprintInDepth) {
   Eigen::MatrixXd V;
   Eigen::MatrixXi F;
   MakeBumpySphere(4, 0.03, &V, &F);
-  const int sphere_faces = static_cast<int>(F.rows());
-  const int n = 32, base = static_cast<int>(V.rows());
-  V.conservativeResize(base + (n + 1) * (n + 1), 3);
-  F.conservativeResize(sphere_faces + 2 * n * n, 3);
-  for (int i = 0; i <= n; ++i) {
-    for (int j = 0; j <= n; ++j) V.row(base + i * (n + 1) + j) << -8 + 16.0 * j / n, -8 + 16.0 * i / n, -1.05;
-  }
-  for (int i = 0, f = sphere_faces; i < n; ++i) {
-    for (int j = 0; j < n; ++j) {
-      const int a = base + i * (n + 1) + j, b = a + 1, c = a + n + 1, d = c + 1;
-      F.row(f++) << a, b, d;  // facing up
-      F.row(f++) << a, d, c;
-    }
-  }
+  const int sphere_faces = static_cast<int>(F.rows()), base = static_cast<int>(V.rows());
+  AppendGrid(Eigen::Vector3d(-8, -8, -1.05), Eigen::Vector3d(16, 0, 0), Eigen::Vector3d(0, 16, 0),
+             32, &V, &F);  // facing up
   const InMemoryViewSource source = MakeTestScene(V, F, {}, {}, renderer_);
   TriangleMesh mesh;
   mesh.V = V;

@@ -153,22 +153,8 @@ TEST(SplitPairsCoveringViews, TwoHalvesEachCoverEveryView) {
 // of n x n cells appended to (V, F).
 void AppendSquareFacingOrigin(double half, double z, int n, Eigen::MatrixXd* V,
                               Eigen::MatrixXi* F) {
-  const int base = static_cast<int>(V->rows()), first_face = static_cast<int>(F->rows());
-  V->conservativeResize(base + (n + 1) * (n + 1), 3);
-  F->conservativeResize(first_face + 2 * n * n, 3);
-  for (int i = 0; i <= n; ++i) {
-    for (int j = 0; j <= n; ++j) {
-      V->row(base + i * (n + 1) + j) << -half + 2 * half * j / n, -half + 2 * half * i / n, z;
-    }
-  }
-  int f = first_face;
-  for (int i = 0; i < n; ++i) {
-    for (int j = 0; j < n; ++j) {
-      const int a = base + i * (n + 1) + j, b = a + 1, c = a + n + 1, d = c + 1;
-      F->row(f++) << a, d, b;  // normal -z, towards the camera at the origin
-      F->row(f++) << a, c, d;
-    }
-  }
+  AppendGrid(Eigen::Vector3d(-half, -half, z), Eigen::Vector3d(0, 2 * half, 0),
+             Eigen::Vector3d(2 * half, 0, 0), n, V, F);
 }
 
 // Two squares at depths 10 and 40 that fill the same part of one image: the

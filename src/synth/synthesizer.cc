@@ -14,6 +14,7 @@
 #include "colmap_io/ply.h"
 #include "colmap_io/sparse_model.h"
 #include "geometry/mesh.h"
+#include "geometry/primitives.h"
 #include "util/error.h"
 #include "util/file.h"
 #include "util/logging.h"
@@ -65,28 +66,8 @@ TriangleMesh LoadGroundTruth(const SynthesizerOptions& options) {
 // screen (the evaluator samples faces, the renderer clips them).
 void AppendGroundPlane(double half_side, int cells, TriangleMesh* mesh) {
   const double z = mesh->V.col(2).minCoeff();
-  const int base = static_cast<int>(mesh->V.rows());
-  const int n = cells + 1;
-  Eigen::MatrixXd V(mesh->V.rows() + n * n, 3);
-  V.topRows(mesh->V.rows()) = mesh->V;
-  for (int i = 0; i < n; ++i) {
-    for (int j = 0; j < n; ++j) {
-      V.row(base + i * n + j) << -half_side + 2 * half_side * j / cells,
-          -half_side + 2 * half_side * i / cells, z;
-    }
-  }
-  Eigen::MatrixXi F(mesh->F.rows() + 2 * cells * cells, 3);
-  F.topRows(mesh->F.rows()) = mesh->F;
-  int f = static_cast<int>(mesh->F.rows());
-  for (int i = 0; i < cells; ++i) {
-    for (int j = 0; j < cells; ++j) {
-      const int a = base + i * n + j, b = a + 1, c = a + n, d = c + 1;
-      F.row(f++) << a, b, d;  // counter-clockwise seen from +z
-      F.row(f++) << a, d, c;
-    }
-  }
-  mesh->V = std::move(V);
-  mesh->F = std::move(F);
+  AppendGrid(Eigen::Vector3d(-half_side, -half_side, z), Eigen::Vector3d(2 * half_side, 0, 0),
+             Eigen::Vector3d(0, 2 * half_side, 0), cells, &mesh->V, &mesh->F);
 }
 
 }  // namespace
