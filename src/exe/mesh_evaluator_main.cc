@@ -53,9 +53,9 @@ int main(int argc, char** argv) {
     manager.Add("min_views", &min_views, "with --workspace_path: views that must see a face (>= 1)");
     std::string region_box;
     manager.Add("region_box", &region_box,
-                "\"x0 y0 z0 x1 y1 z1\" (or with commas): measure only the ground truth whose faces' centroids lie "
-                "in this box (a region of interest, e.g. the object without the ground it stands "
-                "on); with --workspace_path, only its observed part");
+                "\"x0 y0 z0 x1 y1 z1\" (or with commas): measure only the ground truth whose "
+                "faces' centroids lie in this box (a region of interest, e.g. the object without "
+                "the ground it stands on); with --workspace_path, only its observed part");
     std::string sparse_path, true_sparse_path;
     manager.Add("sparse_path", &sparse_path,
                 "COLMAP model (e.g. sparse_refined/) whose cameras are compared with "

@@ -178,8 +178,8 @@ bool RemeshForLevel(const std::vector<PinholeView>& views, const RefineOptions& 
   std::ostringstream edges;
   if (!sizing.uniform()) {
     edges << " of each point's median footprint: " << sizing.band_edges().size()
-          << " depth bands a factor sqrt(2) apart, " << sizing.band_edges().front() << " to " << sizing.band_edges().back()
-          << " scene units";
+          << " depth bands a factor sqrt(2) apart, " << sizing.band_edges().front() << " to "
+          << sizing.band_edges().back() << " scene units";
   }
   MR_LOG(INFO) << "Remeshed " << faces_before << " -> " << F->rows() << " faces (edge "
                << sizing.edge_px() << " px at this level" << edges.str() << ", "

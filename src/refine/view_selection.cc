@@ -158,16 +158,14 @@ EdgeSizing::EdgeSizing(std::vector<PinholeView> views, const Eigen::MatrixXd& V,
       break;
     }
   }
-  // Each face's band; those in use lie between the 1st and the 99th
-  // percentile of the seen area (a few faces at the edge of a view's
-  // frustum do not add a band to an object).
-  std::vector<int> step(F.rows(), kUnseen);
+  // The bands in use lie between the 1st and the 99th percentile of the
+  // seen area (a few faces at the edge of a view's frustum do not add a band
+  // to an object).
   std::vector<std::pair<int, double>> seen;  // (band step, area)
   double seen_area = 0;
   for (int f = 0; f < F.rows(); ++f) {
     if (!(footprint[f] > 0)) continue;
-    step[f] = HalfOctaveOf(footprint[f]);
-    seen.emplace_back(step[f], areas(f));
+    seen.emplace_back(BandStepOf(footprint[f]), areas(f));
     seen_area += areas(f);
   }
   std::sort(seen.begin(), seen.end());
@@ -190,10 +188,7 @@ EdgeSizing::EdgeSizing(std::vector<PinholeView> views, const Eigen::MatrixXd& V,
   if (num_bands == 1) {
     band_area[0] = areas.sum();
   } else {
-    for (int f = 0; f < F.rows(); ++f) {
-      const int k = step[f] == kUnseen ? max_step_ : step[f];
-      band_area[std::clamp(k, min_step_, max_step_) - min_step_] += areas(f);
-    }
+    for (int f = 0; f < F.rows(); ++f) band_area[BandOfFootprint(footprint[f])] += areas(f);
     for (int b = 0; b < num_bands; ++b) {
       band_footprint[b] = median_footprint_ * std::exp2(anchor_ + kBandWidth * (b + min_step_));
     }
@@ -223,16 +218,19 @@ double EdgeSizing::Footprint(const Eigen::Vector3d& x, const Eigen::Vector3d& n)
   return UpperMedian(&footprints);
 }
 
-int EdgeSizing::HalfOctaveOf(double footprint) const {
+int EdgeSizing::BandStepOf(double footprint) const {
   constexpr int kMaxSteps = 20;  // a factor of 1000 either way
   const double steps = std::round((std::log2(footprint / median_footprint_) - anchor_) / kBandWidth);
   return static_cast<int>(std::clamp(steps, -double(kMaxSteps), double(kMaxSteps)));
 }
 
+int EdgeSizing::BandOfFootprint(double footprint) const {
+  const int step = footprint > 0 ? BandStepOf(footprint) : max_step_;
+  return std::clamp(step, min_step_, max_step_) - min_step_;
+}
+
 int EdgeSizing::BandOf(const Eigen::Vector3d& x, const Eigen::Vector3d& n) const {
-  const double footprint = Footprint(x, n);
-  const int k = footprint > 0 ? HalfOctaveOf(footprint) : max_step_;
-  return std::clamp(k, min_step_, max_step_) - min_step_;
+  return BandOfFootprint(Footprint(x, n));
 }
 
 int RemeshedFaceCount(const std::vector<PinholeView>& views, const Eigen::MatrixXd& V,

@@ -106,9 +106,11 @@ class EdgeSizing {
  private:
   // The footprint at x (normal n), 0 where no view sees it.
   double Footprint(const Eigen::Vector3d& x, const Eigen::Vector3d& n) const;
-  // 2 (log2(footprint / median footprint) - anchor), rounded: the band step.
-  int HalfOctaveOf(double footprint) const;
-  static constexpr int kUnseen = 1 << 20;
+  // (log2(footprint / median footprint) - anchor) / kBandWidth, rounded: the
+  // band step, relative to the centre band.
+  int BandStepOf(double footprint) const;
+  // The index into band_edges() of a footprint (0: unseen, the farthest).
+  int BandOfFootprint(double footprint) const;
   // Width of a band, in octaves (log2 of the footprint).
   static constexpr double kBandWidth = 0.5;
   std::vector<PinholeView> views_;
