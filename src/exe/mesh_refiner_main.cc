@@ -282,8 +282,7 @@ int Run(int argc, char** argv) {
                  << w(0) << ", " << w(1) << ", " << w(2) << ")";
   }
 
-  Renderer renderer;
-  MR_LOG(INFO) << "Renderer: " << renderer.Description();
+  Renderer renderer;  // logs "Renderer: <GL vendor, renderer, EGL path>"
 
   // Held-out views: photo-consistency before and after, through all views.
   std::vector<int> holdout_views;

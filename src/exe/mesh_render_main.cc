@@ -171,8 +171,7 @@ int main(int argc, char** argv) {
 
     std::unique_ptr<mr::Renderer> renderer;
     try {
-      renderer = std::make_unique<mr::Renderer>();
-      MR_LOG(INFO) << "Renderer: " << renderer->Description();
+      renderer = std::make_unique<mr::Renderer>();  // logs its description
     } catch (const mr::InputError& e) {
       MR_LOG(WARNING) << "No EGL renderer (" << e.what() << "); using the slow CPU renderer";
     }
