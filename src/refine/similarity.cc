@@ -5,6 +5,9 @@
 #include <vector>
 
 #include <opencv2/imgproc.hpp>
+#ifdef _OPENMP
+#include <omp.h>
+#endif
 
 #include "util/error.h"
 
@@ -38,6 +41,17 @@ bool SimilarityOptions::Check() const {
 
 namespace {
 
+int NumThreads() {
+#ifdef _OPENMP
+  return omp_in_parallel() ? 1 : std::max(1, omp_get_max_threads());
+#else
+  return 1;
+#endif
+}
+
+// Fewer rows per thread than this are filtered on one thread.
+constexpr int kMinBandRows = 32;
+
 // Normalised Gaussian G* with zero padding (self-adjoint), on every channel.
 class GaussianFilter {
  public:
@@ -46,9 +60,20 @@ class GaussianFilter {
     kernel_ = cv::getGaussianKernel(2 * radius + 1, sigma, depth);
     depth_ = depth;
   }
+  // In row bands, one per thread: each band is filtered as a view of `src`,
+  // whose neighbouring rows OpenCV reads for the kernel's reach (only the
+  // image's own border is padded with zeros), so every pixel gets the same
+  // value as when the whole image is filtered at once.
   void Apply(const cv::Mat& src, cv::Mat* dst) const {
-    cv::sepFilter2D(src, *dst, depth_, kernel_, kernel_, cv::Point(-1, -1), 0.0,
-                    cv::BORDER_CONSTANT);
+    dst->create(src.size(), CV_MAKETYPE(depth_, src.channels()));
+    const int bands = std::max(1, std::min(NumThreads(), src.rows / kMinBandRows));
+#pragma omp parallel for schedule(static) if (bands > 1)
+    for (int b = 0; b < bands; ++b) {
+      const cv::Range rows(src.rows * b / bands, src.rows * (b + 1) / bands);
+      cv::Mat band = (*dst)(rows, cv::Range::all());
+      cv::sepFilter2D(src(rows, cv::Range::all()), band, depth_, kernel_, kernel_,
+                      cv::Point(-1, -1), 0.0, cv::BORDER_CONSTANT);
+    }
   }
 
  private:
@@ -125,6 +150,7 @@ void SimilarityOneChannel(const cv::Mat& I1, const cv::Mat& I2, const cv::Mat& M
 
   // Forward: the six masked moments, filtered in one pass.
   cv::Mat F(rows, cols, type6), Fs;
+#pragma omp parallel for schedule(static)
   for (int r = 0; r < rows; ++r) {
     const T* m = M.ptr<T>(r);
     const T* a = I1.ptr<T>(r);
@@ -151,7 +177,9 @@ void SimilarityOneChannel(const cv::Mat& I1, const cv::Mat& I2, const cv::Mat& M
   constexpr int nb = 3;
   cv::Mat R;
   if (compute_gradient) R.create(rows, cols, CV_MAKETYPE(cv::DataType<T>::depth, nb));
-  double cost = 0, zsum = 0, wsum = 0;
+  // Whether pixel (m, omega) has a ZNCC; the cost sums over these pixels.
+  auto supported = [&](T W, T omega) { return W > 0 && omega > 0 && !(omega < min_support); };
+#pragma omp parallel for schedule(static)
   for (int r = 0; r < rows; ++r) {
     const T* m = M.ptr<T>(r);
     const T* fs = Fs.ptr<T>(r);
@@ -161,7 +189,7 @@ void SimilarityOneChannel(const cv::Mat& I1, const cv::Mat& I2, const cv::Mat& M
     for (int c = 0; c < cols; ++c, fs += 6) {
       const T omega = fs[0];
       const T W = m[c];
-      if (!(W > 0) || !(omega > 0) || omega < min_support) {
+      if (!supported(W, omega)) {
         z[c] = 0;
         v2out[c] = eps;
         if (b) std::fill(b + c * nb, b + (c + 1) * nb, T(0));
@@ -177,9 +205,6 @@ void SimilarityOneChannel(const cv::Mat& I1, const cv::Mat& I2, const cv::Mat& M
       const T zn = v12 * inv_s;
       z[c] = zn;
       v2out[c] = v2;
-      cost += static_cast<double>(W) * (1.0 - static_cast<double>(zn));
-      zsum += static_cast<double>(W) * zn;
-      wsum += W;
       if (b) {
         const T inv_v2 = T(1) / v2;
         const T A = W * inv_omega * inv_s;
@@ -192,6 +217,21 @@ void SimilarityOneChannel(const cv::Mat& I1, const cv::Mat& I2, const cv::Mat& M
       }
     }
   }
+  // The sums on one thread, pixel by pixel, so that they do not depend on
+  // the number of threads.
+  double cost = 0, zsum = 0, wsum = 0;
+  for (int r = 0; r < rows; ++r) {
+    const T* m = M.ptr<T>(r);
+    const T* fs = Fs.ptr<T>(r);
+    const T* z = zncc->ptr<T>(r);
+    for (int c = 0; c < cols; ++c, fs += 6) {
+      const T W = m[c];
+      if (!supported(W, fs[0])) continue;
+      cost += static_cast<double>(W) * (1.0 - static_cast<double>(z[c]));
+      zsum += static_cast<double>(W) * z[c];
+      wsum += W;
+    }
+  }
   result->cost += cost;
   result->zncc_sum += zsum;
   result->weight_sum += wsum;
@@ -202,6 +242,7 @@ void SimilarityOneChannel(const cv::Mat& I1, const cv::Mat& I2, const cv::Mat& M
   // x = I1 - c1, y = I2 - c2 (mu1, mu2 are centred the same way).
   cv::Mat Rs;
   G.Apply(R, &Rs);
+#pragma omp parallel for schedule(static)
   for (int r = 0; r < rows; ++r) {
     const T* m = M.ptr<T>(r);
     const T* a = I1.ptr<T>(r);

@@ -1,10 +1,12 @@
 #include "refine/similarity.h"
 
 #include <cmath>
+#include <cstring>
 #include <limits>
 #include <random>
 
 #include <gtest/gtest.h>
+#include <omp.h>
 #include <opencv2/imgproc.hpp>
 
 #include "util/error.h"
@@ -396,6 +398,43 @@ TEST(Similarity, FloatMatchesDouble) {
   f.gradient.convertTo(fg, CV_64F);
   const double gscale = cv::norm(d.gradient, cv::NORM_INF);
   EXPECT_LT(cv::norm(fg, d.gradient, cv::NORM_INF), 1e-4 * gscale);
+}
+
+// The maps are filtered in row bands, one per thread, and the per-pixel
+// loops share the rows: every map and sum must be the same bits as on one
+// thread (which filters the whole image at once), for both precisions.
+TEST(Similarity, SameBitsOnAnyNumberOfThreads) {
+  const int cols = 203, rows = 157;  // bands of unequal height
+  const cv::Mat I1 = RandomImage(cols, rows, 21), I2 = RandomImage(cols, rows, 22);
+  const cv::Mat mask = TestMask(cols, rows);
+  cv::Mat f1, f2;
+  I1.convertTo(f1, CV_32F);
+  I2.convertTo(f2, CV_32F);
+  auto same_bits = [](const cv::Mat& a, const cv::Mat& b) {
+    if (a.size() != b.size() || a.type() != b.type()) return false;
+    for (int r = 0; r < a.rows; ++r) {
+      if (std::memcmp(a.ptr(r), b.ptr(r), a.cols * a.elemSize()) != 0) return false;
+    }
+    return true;
+  };
+  for (const bool double_precision : {true, false}) {
+    SimilarityOptions o = DoubleOptions("dcv", 2, 0.5);
+    o.double_precision = double_precision;
+    o.min_support = 0.2;
+    const int threads = omp_get_max_threads();
+    omp_set_num_threads(1);
+    const SimilarityResult one = ComputeSimilarity(f1, f2, mask, o);
+    omp_set_num_threads(5);
+    const SimilarityResult five = ComputeSimilarity(f1, f2, mask, o);
+    omp_set_num_threads(threads);
+    EXPECT_EQ(one.cost, five.cost) << double_precision;
+    EXPECT_EQ(one.zncc_sum, five.zncc_sum);
+    EXPECT_EQ(one.weight_sum, five.weight_sum);
+    EXPECT_TRUE(same_bits(one.zncc, five.zncc));
+    EXPECT_TRUE(same_bits(one.gradient, five.gradient));
+    EXPECT_TRUE(same_bits(one.variance_predicted, five.variance_predicted));
+    EXPECT_GT(cv::norm(one.gradient, cv::NORM_INF), 0);
+  }
 }
 
 TEST(Similarity, ColorIsSumOfChannels) {
