@@ -149,15 +149,23 @@ void WarpImage(const MeshGeometry& mesh, const PinholeView& view_i, const Render
   MR_CHECK(render_i.width == view_i.width && render_i.height == view_i.height);
   MR_CHECK(render_j.width == view_j.width && render_j.height == view_j.height);
   MR_CHECK((box & cv::Rect(0, 0, view_i.width, view_i.height)) == box);
-  *predicted = cv::Mat::zeros(box.size(), CV_64F);
-  *mask = cv::Mat::zeros(box.size(), CV_8U);
+  // Allocated here and zeroed row by row by the threads (0 outside the valid
+  // domain), not zeroed on one thread first.
+  predicted->create(box.size(), CV_64F);
+  mask->create(box.size(), CV_8U);
   if (derivative != nullptr) {
-    *derivative = cv::Mat::zeros(box.size(), CV_64F);
-    *footprint = cv::Mat::zeros(box.size(), CV_64F);
+    derivative->create(box.size(), CV_64F);
+    footprint->create(box.size(), CV_64F);
   }
 #pragma omp parallel for schedule(dynamic, 8)
   for (int r = 0; r < box.height; ++r) {
     const int row = box.y + r;
+    predicted->row(r).setTo(0);
+    mask->row(r).setTo(0);
+    if (derivative != nullptr) {
+      derivative->row(r).setTo(0);
+      footprint->row(r).setTo(0);
+    }
     PixelWarp warp;
     for (int c = 0; c < box.width; ++c) {
       const int col = box.x + c;
