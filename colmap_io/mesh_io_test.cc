@@ -12,11 +12,7 @@
 namespace mr {
 namespace {
 
-std::string TempPath(const std::string& name) {
-  const std::string dir = JoinPaths(::testing::TempDir(), "mr_mesh_io_test");
-  CreateDirIfNotExists(dir);
-  return JoinPaths(dir, name);
-}
+std::string TempPath(const std::string& name) { return JoinPaths(TestScratchDir(), name); }
 
 void WriteRaw(const std::string& path, const std::string& data) {
   std::ofstream out(path, std::ios::binary | std::ios::trunc);

@@ -17,13 +17,7 @@
 namespace mr {
 namespace {
 
-std::string TempDir() {
-  const std::string dir = JoinPaths(::testing::TempDir(), "mr_ply_test");
-  CreateDirIfNotExists(dir);
-  return dir;
-}
-
-std::string TempPath(const std::string& name) { return JoinPaths(TempDir(), name); }
+std::string TempPath(const std::string& name) { return JoinPaths(TestScratchDir(), name); }
 
 void WriteRaw(const std::string& path, const std::string& data) {
   std::ofstream out(path, std::ios::binary | std::ios::trunc);

@@ -28,6 +28,7 @@
 #include "tests/command.h"
 #include "tests/test_workspace.h"
 #include "util/file.h"
+#include "util/testing.h"
 
 namespace mr {
 namespace {
@@ -539,8 +540,7 @@ std::string BadInputTable::base_;
 
 TEST_P(BadInputTable, RefusedAndNothingChanged) {
   const BadInput& row = GetParam();
-  const std::string dir = (fs::temp_directory_path() / ("mr_bad_input_" + row.name)).string();
-  fs::remove_all(dir);
+  const std::string dir = FreshTestPath("bad_input_" + row.name);
   fs::copy(base_, dir, fs::copy_options::recursive);
   fs::remove(dir + "/complete");
   row.prepare(dir);

@@ -16,6 +16,7 @@
 #include "colmap_io/sparse_model.h"
 #include "tests/command.h"
 #include "util/file.h"
+#include "util/testing.h"
 
 namespace mr {
 namespace {
@@ -26,13 +27,7 @@ const std::string kScript = std::string(MR_SOURCE_DIR) + "/scripts/colmap_pipeli
 const std::string kColmap = MR_COLMAP_EXECUTABLE;
 const std::string kTemple = std::string(MR_SHARED_DIR) + "/data/middlebury/templeSparseRing";
 
-std::string FreshDir(const std::string& name) {
-  const std::string dir = JoinPaths(::testing::TempDir(),
-                                    "mr_pipeline_" + name + "_" + std::to_string(getpid()));
-  fs::remove_all(dir);
-  fs::create_directories(dir);
-  return dir;
-}
+std::string FreshDir(const std::string& name) { return MakeTestDir("pipeline_" + name); }
 
 bool ColmapHasCuda() {
   return RunCommand(kColmap + " -h").output.find("with CUDA") != std::string::npos;

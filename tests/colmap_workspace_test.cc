@@ -14,6 +14,7 @@
 #include "tests/command.h"
 #include "tests/observed_evaluation.h"
 #include "util/file.h"
+#include "util/testing.h"
 
 namespace mr {
 namespace {
@@ -29,9 +30,7 @@ class ColmapWorkspace : public ::testing::Test {
     if (std::string(MR_COLMAP_EXECUTABLE).empty()) GTEST_SKIP() << "colmap not found";
     static std::string dir, log;
     if (dir.empty() && log.empty()) {
-      const std::string candidate =
-          (fs::temp_directory_path() / ("mr_colmap_ws_" + std::to_string(::getpid()))).string();
-      fs::remove_all(candidate);
+      const std::string candidate = FreshTestPath("colmap_ws");
       const CommandResult r = RunCommand(
           std::string(MR_BIN_DIR) + "/workspace_synthesizer --output_path " + candidate +
           " --num_views 10 --width 640 --height 480 --colmap_path " + MR_COLMAP_EXECUTABLE +

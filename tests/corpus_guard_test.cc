@@ -19,6 +19,7 @@
 #include "tests/command.h"
 #include "tests/observed_evaluation.h"
 #include "util/file.h"
+#include "util/testing.h"
 
 namespace mr {
 namespace {
@@ -69,10 +70,7 @@ TEST_P(CorpusGuard, DefaultsImproveTheObservedSurface) {
       !fs::exists(std::string(MR_SHARED_DIR) + "/data/models")) {
     GTEST_SKIP() << "no " << MR_SHARED_DIR << "/data/models";
   }
-  const std::string dir = (fs::temp_directory_path() /
-                           ("mr_corpus_" + std::string(c.name) + "_" + std::to_string(::getpid())))
-                              .string();
-  fs::remove_all(dir);
+  const std::string dir = FreshTestPath("corpus_" + std::string(c.name));
   const CommandResult synth =
       RunCommand(std::string(MR_BIN_DIR) + "/workspace_synthesizer --output_path " + dir + " " +
                  flags + " --colmap_path " + MR_COLMAP_EXECUTABLE +

@@ -11,6 +11,7 @@
 #include "colmap_io/sparse_model.h"
 #include "tests/command.h"
 #include "util/file.h"
+#include "util/testing.h"
 
 namespace mr {
 namespace {
@@ -38,11 +39,9 @@ TriangleMesh Octahedron(double scale) {
 class MeshProgramsCli : public ::testing::Test {
  protected:
   void SetUp() override {
-    dir_ = (fs::temp_directory_path() /
-            ("mr_cli_programs_" +
-             std::string(::testing::UnitTest::GetInstance()->current_test_info()->name())))
-               .string();
-    fs::remove_all(dir_);
+    dir_ = FreshTestPath(
+        "cli_programs_" +
+        std::string(::testing::UnitTest::GetInstance()->current_test_info()->name()));
     fs::create_directories(dir_ + "/sub");
     WritePly(dir_ + "/m.ply", Octahedron(1.0));
     WritePly(dir_ + "/gt.ply", Octahedron(1.01));

@@ -26,6 +26,7 @@
 #include "tests/command.h"
 #include "tests/test_workspace.h"
 #include "util/file.h"
+#include "util/testing.h"
 
 namespace mr {
 namespace {
@@ -40,9 +41,8 @@ const std::string kFast =
 class MeshRefinerCli : public ::testing::Test {
  protected:
   void SetUp() override {
-    dir_ = fs::temp_directory_path() /
-           ("mr_cli_ws_" + std::string(::testing::UnitTest::GetInstance()->current_test_info()->name()));
-    fs::remove_all(dir_);
+    dir_ = FreshTestPath(
+        "cli_ws_" + std::string(::testing::UnitTest::GetInstance()->current_test_info()->name()));
     WriteRenderedTestWorkspace(dir_);
     TriangleMesh initial;
     MakeIcosphere(3, 1.0, &initial.V, &initial.F);

@@ -13,6 +13,7 @@
 #include "colmap_io/mesh_io.h"
 #include "util/error.h"
 #include "util/file.h"
+#include "util/testing.h"
 
 namespace mr {
 namespace {
@@ -292,8 +293,7 @@ TEST(EvaluationResult, ToJsonIsOneLine) {
 TEST(MeshEvaluator, CommandLine) {
   const std::string exe = JoinPaths(MR_BIN_DIR, "mesh_evaluator");
   if (!ExistsFile(exe)) GTEST_SKIP() << exe << " not built";
-  const std::string dir = JoinPaths(::testing::TempDir(), "mr_evaluator_test");
-  CreateDirIfNotExists(dir);
+  const std::string dir = MakeTestDir("evaluator_command_line");
   const Mesh plane = Plane(4);
   TriangleMesh recon, gt;
   recon.V = plane.V;
@@ -338,6 +338,7 @@ TEST(MeshEvaluator, CommandLine) {
 
 #include "geometry/mesh.h"
 #include "geometry/primitives.h"
+#include "util/testing.h"
 
 namespace mr {
 namespace {

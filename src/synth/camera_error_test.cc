@@ -19,18 +19,14 @@
 #include "synth/synthesizer.h"
 #include "util/error.h"
 #include "util/file.h"
+#include "util/testing.h"
 
 namespace mr {
 namespace {
 
 constexpr double kPi = 3.14159265358979323846;
 
-std::string FreshDir(const std::string& name) {
-  const std::string dir = JoinPaths(::testing::TempDir(),
-                                    "mr_camera_error_" + name + "_" + std::to_string(getpid()));
-  std::filesystem::remove_all(dir);
-  return dir;
-}
+std::string FreshDir(const std::string& name) { return FreshTestPath("camera_error_" + name); }
 
 // #n by 3 points evenly spread over a sphere of `radius` about the origin
 // (Fibonacci spiral).

@@ -23,18 +23,14 @@
 #include "util/error.h"
 #include "util/file.h"
 #include "util/logging.h"
+#include "util/testing.h"
 
 namespace mr {
 namespace {
 
 using testing_util::PointMeshDistance;
 
-std::string FreshDir(const std::string& name) {
-  const std::string dir = JoinPaths(::testing::TempDir(),
-                                    "mr_synth_" + name + "_" + std::to_string(getpid()));
-  std::filesystem::remove_all(dir);
-  return dir;
-}
+std::string FreshDir(const std::string& name) { return FreshTestPath("synth_" + name); }
 
 SynthesizerOptions SmallOptions(const std::string& output_path) {
   SynthesizerOptions options;
