@@ -30,14 +30,7 @@ if [ "${BASELINE:-1}" != 0 ]; then
 fi
 if [ -n "${CONFIGS:-}" ]; then configs+=$'\n'"$CONFIGS"; fi
 
-cases=$(grep -v '^#' "$CORPUS" | grep -v '^\s*$' | cut -d'|' -f1 | tr -d ' ')
-if [ $# -gt 0 ]; then cases="$*"; fi
-
-evaluate() {  # case mesh -> json on stdout
-  # shellcheck disable=SC2046
-  "$BIN/mesh_evaluator" --input_path "$2" --gt_path "$OUT/$1/ground_truth.ply" \
-    --workspace_path "$OUT/$1/dense" $(case_eval_flags "$1")
-}
+cases=$(corpus_cases "$@")
 
 TSV="$OUT/results.tsv"
 : > "$TSV"
@@ -51,7 +44,7 @@ for name in $cases; do
     "$BIN/workspace_synthesizer" --output_path "$ws" $flags > "$OUT/$name.synth.log" 2>&1
   fi
   if [ ! -f "$OUT/$name.input.json" ]; then
-    evaluate "$name" "$ws/dense/meshed-poisson.ply" > "$OUT/$name.input.json"
+    evaluate_case "$name" "$ws/dense/meshed-poisson.ply" > "$OUT/$name.input.json"
   fi
   printf '%s\tinput\t%s\t0\t0\n' "$name" "$(cat "$OUT/$name.input.json")" >> "$TSV"
   while IFS= read -r config; do
@@ -76,7 +69,7 @@ for name in $cases; do
       /usr/bin/time -f "%e %M" -o "$stem.time" "$BIN/mesh_refiner" --workspace_path "$refine_ws" \
         --output_path "$out" $rflags > "$stem.log" 2>&1 || {
           echo "mesh_refiner failed on $name ($label): see $stem.log" >&2; continue; }
-      evaluate "$name" "$out" > "$stem.json"
+      evaluate_case "$name" "$out" > "$stem.json"
     fi
     read -r secs kb < "$stem.time"
     printf '%s\t%s\t%s\t%s\t%s\n' "$name" "$label$suffix" "$(cat "$stem.json")" "$secs" "$((kb / 1024))" >> "$TSV"

@@ -18,14 +18,7 @@ cd "$(dirname "$0")/../.."
 source benchmark/refine/corpus_lib.sh
 LABEL=${LABEL:-defaults}
 
-cases=$(grep -v '^#' "$CORPUS" | grep -v '^\s*$' | cut -d'|' -f1 | tr -d ' ')
-if [ $# -gt 0 ]; then cases="$*"; fi
-
-evaluate() {  # case mesh -> json on stdout
-  # shellcheck disable=SC2046
-  "$BIN/mesh_evaluator" --input_path "$2" --gt_path "$OUT/$1/ground_truth.ply" \
-    --workspace_path "$OUT/$1/dense" $(case_eval_flags "$1")
-}
+cases=$(corpus_cases "$@")
 
 TSV="$OUT/fixed_point.$LABEL.tsv"
 : > "$TSV"
@@ -35,7 +28,7 @@ for name in $cases; do
     echo "skipping $name: no workspace (run run_corpus.sh $OUT $name first)" >&2
     continue
   fi
-  [ -f "$OUT/$name.input.json" ] || evaluate "$name" "$ws/dense/meshed-poisson.ply" > "$OUT/$name.input.json"
+  [ -f "$OUT/$name.input.json" ] || evaluate_case "$name" "$ws/dense/meshed-poisson.ply" > "$OUT/$name.input.json"
   for run in gt0 "gt.$LABEL"; do
     out="$OUT/$name.$run.ply"
     if [ ! -f "$OUT/$name.$run.json" ]; then
@@ -45,7 +38,7 @@ for name in $cases; do
       # shellcheck disable=SC2086
       "$BIN/mesh_refiner" --workspace_path "$ws/dense" --input_path "$ws/ground_truth.ply" \
         --output_path "$out" $extra > "$OUT/$name.$run.log" 2>&1
-      evaluate "$name" "$out" > "$OUT/$name.$run.json"
+      evaluate_case "$name" "$out" > "$OUT/$name.$run.json"
     fi
   done
   printf '%s\t%s\t%s\t%s\t%s\n' "$name" "$(cat "$OUT/$name.input.json")" \
