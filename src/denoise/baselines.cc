@@ -6,6 +6,8 @@
 
 #include <Eigen/Geometry>
 
+#include "geometry/mesh.h"
+
 namespace mr {
 namespace {
 
@@ -164,7 +166,7 @@ Eigen::MatrixXd BilateralNormalFilter(const Eigen::MatrixXd& V, const Eigen::Mat
     X = Xn;
 #pragma omp parallel for schedule(static) if (n > 50000)
     for (int f = 0; f < nf; ++f) {
-      C.row(f) = (X.row(F(f, 0)) + X.row(F(f, 1)) + X.row(F(f, 2))) / 3.0;
+      C.row(f) = FaceCentroid(X, F, f).transpose();
     }
   }
   return X;

@@ -359,7 +359,7 @@ long KeepFacesInBox(const Eigen::MatrixXd& V, const Eigen::MatrixXi& F, const Re
   MR_CHECK_EQ(static_cast<long>(flags->size()), static_cast<long>(F.rows()));
   long kept = 0;
   for (int f = 0; f < F.rows(); ++f) {
-    const Eigen::Vector3d c = (V.row(F(f, 0)) + V.row(F(f, 1)) + V.row(F(f, 2))) / 3.0;
+    const Eigen::Vector3d c = FaceCentroid(V, F, f);
     if (!box.Contains(c)) (*flags)[f] = 0;
     kept += (*flags)[f] != 0;
   }

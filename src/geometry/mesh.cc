@@ -181,8 +181,7 @@ std::vector<int> OrderSpatially(Eigen::MatrixXd* V, Eigen::MatrixXi* F) {
   const double cells = (1 << 21) - 1;
   std::vector<std::pair<uint64_t, int>> keyed(num_faces);
   for (int f = 0; f < num_faces; ++f) {
-    const Eigen::RowVector3d c =
-        (V->row((*F)(f, 0)) + V->row((*F)(f, 1)) + V->row((*F)(f, 2))) / 3.0;
+    const Eigen::Vector3d c = FaceCentroid(*V, *F, f);
     uint64_t code = 0;
     for (int a = 0; a < 3; ++a) {
       const double t = std::clamp((c(a) - lo(a)) / extent, 0.0, 1.0);

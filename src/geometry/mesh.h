@@ -9,6 +9,11 @@
 namespace mr {
 
 // #F by 3 unit face normals (zero rows for degenerate faces).
+// The centroid of face f.
+inline Eigen::Vector3d FaceCentroid(const Eigen::MatrixXd& V, const Eigen::MatrixXi& F, int f) {
+  return (V.row(F(f, 0)) + V.row(F(f, 1)) + V.row(F(f, 2))).transpose() / 3.0;
+}
+
 Eigen::MatrixXd FaceNormals(const Eigen::MatrixXd& V, const Eigen::MatrixXi& F);
 // #F face areas.
 Eigen::VectorXd FaceAreas(const Eigen::MatrixXd& V, const Eigen::MatrixXi& F);

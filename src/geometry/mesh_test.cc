@@ -160,7 +160,7 @@ TEST(Primitives, IcosphereIsClosedAndOutward) {
   EXPECT_EQ(topo.NumNonManifoldEdges(), 0);
   const Eigen::MatrixXd N = FaceNormals(V, F);
   for (int f = 0; f < F.rows(); ++f) {
-    const Eigen::Vector3d c = (V.row(F(f, 0)) + V.row(F(f, 1)) + V.row(F(f, 2))) / 3.0;
+    const Eigen::Vector3d c = FaceCentroid(V, F, f);
     EXPECT_GT(N.row(f).dot(c), 0) << "face " << f << " points inward";
   }
   EXPECT_NEAR(V.rowwise().norm().maxCoeff(), 2.0, 1e-12);

@@ -40,7 +40,7 @@ double MaxRadiusError(const Eigen::MatrixXd& V) {
 double MaxCentroidRadiusError(const Eigen::MatrixXd& V, const Eigen::MatrixXi& F) {
   double e = 0;
   for (int f = 0; f < F.rows(); ++f) {
-    const Eigen::Vector3d c = (V.row(F(f, 0)) + V.row(F(f, 1)) + V.row(F(f, 2))) / 3.0;
+    const Eigen::Vector3d c = FaceCentroid(V, F, f);
     e = std::max(e, std::abs(c.norm() - 1.0));
   }
   return e;
@@ -95,7 +95,7 @@ TEST(Decimate, GarlandHeckbertReachesTargetAndKeepsSphere) {
   // Still outward: every face normal points away from the centre.
   const Eigen::MatrixXd N = FaceNormals(V, F);
   for (int f = 0; f < F.rows(); ++f) {
-    const Eigen::Vector3d c = (V.row(F(f, 0)) + V.row(F(f, 1)) + V.row(F(f, 2))) / 3.0;
+    const Eigen::Vector3d c = FaceCentroid(V, F, f);
     ASSERT_GT(N.row(f).dot(c.normalized()), 0.5) << "face " << f;
   }
 }
@@ -370,7 +370,7 @@ TEST(CleanMesh, ZeroAreaCapIsFlippedAway) {
   // Orientation is still outward everywhere.
   const Eigen::MatrixXd N = FaceNormals(V, F);
   for (int f = 0; f < F.rows(); ++f) {
-    const Eigen::Vector3d c = (V.row(F(f, 0)) + V.row(F(f, 1)) + V.row(F(f, 2))) / 3.0;
+    const Eigen::Vector3d c = FaceCentroid(V, F, f);
     ASSERT_GT(N.row(f).dot(c.normalized()), 0) << "face " << f;
   }
 }

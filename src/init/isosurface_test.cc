@@ -55,7 +55,7 @@ TEST(ExtractIsosurface, SphereSdfIsWatertightOrientedAndAccurate) {
   const Eigen::MatrixXd N = FaceNormals(V, F);
   int inward = 0;
   for (Eigen::Index f = 0; f < F.rows(); ++f) {
-    const Eigen::Vector3d c = (V.row(F(f, 0)) + V.row(F(f, 1)) + V.row(F(f, 2))) / 3.0;
+    const Eigen::Vector3d c = FaceCentroid(V, F, f);
     inward += N.row(f).dot(c.normalized()) < 0;
   }
   EXPECT_EQ(inward, 0);

@@ -41,7 +41,9 @@ bool SimilarityOptions::Check() const {
 
 namespace {
 
-int NumThreads() {
+// The threads a filter may split into bands here: 1 inside a parallel region
+// (the caller's threads are taken), else OpenMP's maximum.
+int ThreadsForBands() {
 #ifdef _OPENMP
   return omp_in_parallel() ? 1 : std::max(1, omp_get_max_threads());
 #else
@@ -66,7 +68,7 @@ class GaussianFilter {
   // value as when the whole image is filtered at once.
   void Apply(const cv::Mat& src, cv::Mat* dst) const {
     dst->create(src.size(), CV_MAKETYPE(depth_, src.channels()));
-    const int bands = std::max(1, std::min(NumThreads(), src.rows / kMinBandRows));
+    const int bands = std::max(1, std::min(ThreadsForBands(), src.rows / kMinBandRows));
 #pragma omp parallel for schedule(static) if (bands > 1)
     for (int b = 0; b < bands; ++b) {
       const cv::Range rows(src.rows * b / bands, src.rows * (b + 1) / bands);

@@ -131,7 +131,7 @@ EdgeSizing::EdgeSizing(std::vector<PinholeView> views, const Eigen::MatrixXd& V,
   std::vector<double> footprint(F.rows());
   std::vector<std::pair<double, double>> logs;  // (log2(footprint / m), area)
   for (int f = 0; f < F.rows(); ++f) {
-    const Eigen::Vector3d c = (V.row(F(f, 0)) + V.row(F(f, 1)) + V.row(F(f, 2))) / 3.0;
+    const Eigen::Vector3d c = FaceCentroid(V, F, f);
     footprint[f] = Footprint(c, N.row(f));
     if (footprint[f] > 0) logs.emplace_back(std::log2(footprint[f] / median_footprint_), areas(f));
   }
