@@ -9,23 +9,19 @@
 #include <string>
 #include <vector>
 
-#include <unistd.h>
-
 #include "colmap_io/sparse_model.h"
+#include "util/testing.h"
 
 namespace mr {
 namespace test {
 
-// A fresh, empty folder removed on destruction.
+// A fresh, empty folder in the test process's scratch folder
+// (util/testing.h), removed on destruction.
 class TempDir {
  public:
   explicit TempDir(const std::string& tag) {
     static std::atomic<int> counter{0};
-    path_ = (std::filesystem::temp_directory_path() /
-             ("mr_" + tag + "_" + std::to_string(::getpid()) + "_" + std::to_string(counter++)))
-                .string();
-    std::filesystem::remove_all(path_);
-    std::filesystem::create_directories(path_);
+    path_ = MakeTestDir(tag + "_" + std::to_string(counter++));
   }
   ~TempDir() {
     std::error_code ec;

@@ -79,12 +79,7 @@ double ReliefRms(const Eigen::MatrixXd& V) {
 void MakeFineRelief(double edges, Eigen::MatrixXd* V, Eigen::MatrixXi* F) {
   MakeIcosphere(5, 1.0, V, F);
   const double edge = (V->row((*F)(0, 0)) - V->row((*F)(0, 1))).norm();
-  const double k = 2.0 * M_PI / (edges * edge);
-  for (int i = 0; i < V->rows(); ++i) {
-    const Eigen::Vector3d p = V->row(i);
-    const double bump = std::sin(k * p.x()) * std::sin(k * p.y() + 1.0) * std::cos(k * p.z());
-    V->row(i) = (p * (1.0 + 0.5 * edge * bump)).transpose();
-  }
+  MakeBumpySphere(5, 0.5 * edge, V, F, Eigen::Vector3d::Constant(2.0 * M_PI / (edges * edge)));
 }
 
 // The refiner's proximal step on a noise-free surface with fine relief, with

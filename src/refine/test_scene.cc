@@ -28,11 +28,14 @@ Eigen::MatrixXd SceneTransform::Apply(const Eigen::MatrixXd& V) const {
   return out;
 }
 
-void MakeBumpySphere(int subdivisions, double relief, Eigen::MatrixXd* V, Eigen::MatrixXi* F) {
+void MakeBumpySphere(int subdivisions, double relief, Eigen::MatrixXd* V, Eigen::MatrixXi* F,
+                     const Eigen::Vector3d& wavenumbers) {
   MakeIcosphere(subdivisions, 1.0, V, F);
+  const Eigen::Vector3d& k = wavenumbers;
   for (int i = 0; i < V->rows(); ++i) {
     const Eigen::Vector3d p = V->row(i);
-    const double bump = std::sin(5.0 * p.x()) * std::sin(4.0 * p.y() + 1.0) * std::cos(3.0 * p.z());
+    const double bump =
+        std::sin(k.x() * p.x()) * std::sin(k.y() * p.y() + 1.0) * std::cos(k.z() * p.z());
     V->row(i) = (p * (1.0 + relief * bump)).transpose();
   }
 }

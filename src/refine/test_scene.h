@@ -34,8 +34,10 @@ struct TestSceneOptions {
   int supersample = 2;
 };
 
-// A closed bumpy sphere of radius ~1 (icosphere with radial relief).
-void MakeBumpySphere(int subdivisions, double relief, Eigen::MatrixXd* V, Eigen::MatrixXi* F);
+// A closed bumpy sphere of radius ~1 (icosphere with radial relief
+// relief * sin(k_x x) sin(k_y y + 1) cos(k_z z), k = `wavenumbers`).
+void MakeBumpySphere(int subdivisions, double relief, Eigen::MatrixXd* V, Eigen::MatrixXi* F,
+                     const Eigen::Vector3d& wavenumbers = Eigen::Vector3d(5, 4, 3));
 
 // Renders the canonical-frame mesh (V, F), moved by `transform`, into a ring
 // of views, with a solid texture evaluated in the canonical frame.
