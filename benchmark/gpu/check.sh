@@ -8,8 +8,9 @@
 #
 # Steps: render_probe at 640x480 and 1920x1440 (stops unless the renderer is
 # NVIDIA's); the example three times on all cores and, with taskset, three
-# times on two cores, each scored against the ground truth; workspaces a and
-# b (if bundled): images rendered again by workspace_synthesizer from the
+# times on two cores, each scored against the ground truth; run_large.sh's
+# c (the example's mesh remeshed to 2M faces there, then refined; LARGE_C=0
+# skips it); workspaces a and b (if bundled): images rendered again by workspace_synthesizer from the
 # bundled options (no COLMAP there: the bundled Poisson mesh stands in for
 # its fusion and meshing), refined with the defaults and scored.
 # REQUIRE_NVIDIA=0 runs it on any renderer (to try the script on a CPU).
@@ -82,6 +83,21 @@ if command -v taskset > /dev/null; then
   score example_2_cores_out "$D/example_2_cores_1.ply" "$EX"
 fi
 echo "example done after $((SECONDS - T0)) s"
+
+# c of run_large.sh: the example's Poisson mesh remeshed to about 2M faces
+# there (as run_large.sh does), then refined with the defaults. LARGE_C=0
+# skips it.
+if [ "${LARGE_C:-1}" != 0 ]; then
+  timed c_make_2m "$B/mesh_refiner" --workspace_path "$EX/dense" --output_path "$D/meshed-2m.ply" \
+    --Refine.iterations_per_level 0 --Refine.num_levels 1 --Refine.target_edge_px 0.7 \
+    --Refine.max_faces 2200000
+  timed c_refine "$B/mesh_refiner" --workspace_path "$EX/dense" --input_path "$D/meshed-2m.ply" \
+    --output_path "$D/c_refined.ply"
+  grep -E "Decimate:|  time:" "$LOGS/c_refine.log"
+  score c_in "$D/meshed-2m.ply" "$EX"
+  score c_out "$D/c_refined.ply" "$EX"
+  echo "c done after $((SECONDS - T0)) s"
+fi
 
 for c in a b; do
   [ -d "$D/$c" ] || continue

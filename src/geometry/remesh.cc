@@ -5,11 +5,16 @@
 #include "geometry/remesh.h"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
+#include <exception>
 #include <iterator>
+#include <map>
 #include <sstream>
 #include <utility>
 #include <vector>
+
+#include <Eigen/Geometry>
 
 #include <CGAL/Bbox_3.h>
 #include <CGAL/box_intersection_d.h>
@@ -29,6 +34,10 @@
 #include <CGAL/Surface_mesh_simplification/Policies/Edge_collapse/LindstromTurk_placement.h>
 #include <CGAL/Surface_mesh_simplification/edge_collapse.h>
 #include <CGAL/subdivision_method_3.h>
+
+#ifdef _OPENMP
+#include <omp.h>
+#endif
 
 #include "geometry/mesh.h"
 #include "util/error.h"
@@ -98,17 +107,37 @@ struct FaceCountStop {
   }
 };
 
+using VertexFlags = Mesh::Property_map<Mesh::Vertex_index, bool>;
+
+// A placement that refuses every collapse of an edge with an end in *fixed
+// (when given), so that those vertices keep their identity, position and
+// neighbours: the cuts between spatial pieces (DecimateOptions::
+// faces_per_piece) and the triangles along them stay as they are.
+template <typename Base>
+struct KeepFixedVertices {
+  Base base;
+  const VertexFlags* fixed;
+  template <typename Profile>
+  boost::optional<typename Profile::Point> operator()(const Profile& profile) const {
+    if (fixed != nullptr && ((*fixed)[profile.v0()] || (*fixed)[profile.v1()])) {
+      return boost::none;
+    }
+    return base(profile);
+  }
+};
+
+// Collapses edges down to `target` faces; see KeepFixedVertices for *fixed.
 template <typename Cost, typename Placement>
 int CollapseEdges(Mesh* mesh, std::size_t target, const Cost& cost, const Placement& placement,
-                  bool bounded_normal_change, const std::atomic<bool>* cancel) {
-  const FaceCountStop stop{mesh, target, cancel};
-  if (bounded_normal_change) {
-    const SMS::Bounded_normal_change_filter<> filter;
-    return SMS::edge_collapse(
-        *mesh, stop, CGAL::parameters::get_cost(cost).get_placement(placement).filter(filter));
+                  const DecimateOptions& options, const VertexFlags* fixed) {
+  const FaceCountStop stop{mesh, target, options.cancel};
+  const KeepFixedVertices<Placement> keep{placement, fixed};
+  if (options.bounded_normal_change) {
+    return SMS::edge_collapse(*mesh, stop,
+                              CGAL::parameters::get_cost(cost).get_placement(keep).filter(
+                                  SMS::Bounded_normal_change_filter<>()));
   }
-  return SMS::edge_collapse(*mesh, stop,
-                            CGAL::parameters::get_cost(cost).get_placement(placement));
+  return SMS::edge_collapse(*mesh, stop, CGAL::parameters::get_cost(cost).get_placement(keep));
 }
 
 // Runs a CGAL call; a CGAL precondition/assertion failure (almost always
@@ -139,11 +168,233 @@ std::string DecimateSummary::BriefReport() const {
   std::ostringstream s;
   s << policy << ": faces " << initial_faces << " -> " << final_faces << ", vertices "
     << initial_vertices << " -> " << final_vertices << ", " << collapsed_edges
-    << " edges collapsed in " << seconds << " s"
-    << (target_not_reached ? " (target NOT reached: collapses blocked)" : "")
+    << " edges collapsed in " << seconds << " s";
+  if (pieces > 1) s << " (" << pieces << " pieces on " << threads << " threads)";
+  s << (target_not_reached ? " (target NOT reached: collapses blocked)" : "")
     << (cancelled ? " (cancelled)" : "");
   return s.str();
 }
+
+namespace {
+
+// Collapses edges of `mesh` down to `target` faces with the options' policy,
+// leaving the vertices marked in *fixed (when given) and the triangles
+// around them as they are. Returns the number of collapses.
+int DecimateMesh(Mesh* mesh, int target, const DecimateOptions& options,
+                 const VertexFlags* fixed) {
+  int collapsed = 0;
+  RunCgal("Decimate", [&] {
+    if (options.policy == "garland_heckbert") {
+      const SMS::GarlandHeckbert_plane_policies<Mesh, Kernel> gh(*mesh);
+      collapsed = CollapseEdges(mesh, target, gh.get_cost(), gh.get_placement(), options, fixed);
+    } else {
+      collapsed = CollapseEdges(mesh, target, SMS::LindstromTurk_cost<Mesh>(),
+                                SMS::LindstromTurk_placement<Mesh>(), options, fixed);
+    }
+  });
+  mesh->collect_garbage();
+  return collapsed;
+}
+
+// The spatial piece of every face: the faces' centroids cut at their median
+// along the longest side of their box, again and again, until no piece has
+// more than `max_faces` faces (2^k pieces). Sets *num_pieces.
+std::vector<int> SpatialPieces(const Eigen::MatrixXd& V, const Eigen::MatrixXi& F, int max_faces,
+                               int* num_pieces) {
+  const int n = static_cast<int>(F.rows());
+  std::vector<Eigen::Vector3d> centroid(n);
+  for (int f = 0; f < n; ++f) centroid[f] = FaceCentroid(V, F, f);
+  std::vector<int> order(n);
+  for (int f = 0; f < n; ++f) order[f] = f;
+  int pieces = 1;
+  while (n / pieces > max_faces && pieces < (1 << 12)) pieces *= 2;
+  // Piece p holds order[bounds[p], bounds[p + 1]); each round halves all.
+  std::vector<int> bounds = {0, n};
+  while (static_cast<int>(bounds.size()) - 1 < pieces) {
+    std::vector<int> next = {0};
+    for (size_t p = 0; p + 1 < bounds.size(); ++p) {
+      const auto begin = order.begin() + bounds[p], end = order.begin() + bounds[p + 1];
+      Eigen::AlignedBox3d box;
+      for (auto it = begin; it != end; ++it) box.extend(centroid[*it]);
+      int axis = 0;
+      box.sizes().maxCoeff(&axis);
+      const auto middle = begin + (end - begin) / 2;
+      std::nth_element(begin, middle, end, [&](int a, int b) {
+        return centroid[a][axis] < centroid[b][axis] || (centroid[a][axis] == centroid[b][axis] && a < b);
+      });
+      next.push_back(static_cast<int>(middle - order.begin()));
+      next.push_back(bounds[p + 1]);
+    }
+    bounds = std::move(next);
+  }
+  std::vector<int> piece(n);
+  for (int p = 0; p + 1 < static_cast<int>(bounds.size()); ++p) {
+    for (int k = bounds[p]; k < bounds[p + 1]; ++k) piece[order[k]] = p;
+  }
+  *num_pieces = pieces;
+  return piece;
+}
+
+// Decimate on spatial pieces (DecimateOptions::faces_per_piece): each piece
+// is decimated on a thread of its own to its share of the target, leaving
+// the vertices on its cuts and the triangles around them as they are; the
+// pieces are then joined at those vertices, by their (unchanged) positions.
+// Returns false, leaving (V, F) as they were, when a piece is not a
+// 2-manifold by itself even with its pinched vertices split, or a cut vertex
+// shares its position with another vertex; the caller then decimates the
+// whole.
+bool DecimateInPieces(Eigen::MatrixXd* V, Eigen::MatrixXi* F, int target_faces,
+                      const DecimateOptions& options, DecimateSummary* summary) {
+  int num_pieces = 1;
+  const std::vector<int> piece = SpatialPieces(*V, *F, options.faces_per_piece, &num_pieces);
+  // A vertex is on a cut when its faces lie in more than one piece.
+  std::vector<int> first_piece(V->rows(), -1);
+  std::vector<char> on_cut(V->rows(), 0);
+  for (int f = 0; f < F->rows(); ++f) {
+    for (int k = 0; k < 3; ++k) {
+      int& p = first_piece[(*F)(f, k)];
+      if (p < 0) p = piece[f];
+      if (p != piece[f]) on_cut[(*F)(f, k)] = 1;
+    }
+  }
+  std::vector<std::vector<int>> faces_of(num_pieces);
+  for (int f = 0; f < F->rows(); ++f) faces_of[piece[f]].push_back(f);
+  // The cut vertices by position, at which the pieces are joined.
+  std::map<std::array<double, 3>, int> cut_at;
+  for (int v = 0; v < V->rows(); ++v) {
+    if (on_cut[v]) cut_at.emplace(std::array<double, 3>{(*V)(v, 0), (*V)(v, 1), (*V)(v, 2)}, v);
+  }
+  // A cut vertex must be the only vertex at its position (CleanMesh merges
+  // such duplicates).
+  long at_cut_positions = 0;
+  for (int v = 0; v < V->rows(); ++v) {
+    at_cut_positions += cut_at.count({(*V)(v, 0), (*V)(v, 1), (*V)(v, 2)});
+  }
+  if (at_cut_positions != static_cast<long>(cut_at.size())) {
+    MR_LOG(INFO) << "Decimate: a vertex on a cut between pieces shares its position with "
+                    "another; decimating the mesh as a whole";
+    return false;
+  }
+
+  struct Piece {
+    Eigen::MatrixXd V;
+    Eigen::MatrixXi F;
+    std::vector<int> input;  // the input row of each cut vertex of V, else -1
+    int collapsed = 0;
+    bool manifold = true;
+    std::exception_ptr error;
+  };
+  std::vector<Piece> out(num_pieces);
+  const double share = double(target_faces) / double(F->rows());
+  int threads = 1;
+#pragma omp parallel
+  {
+#ifdef _OPENMP
+#pragma omp single
+    threads = omp_get_num_threads();
+#endif
+#pragma omp for schedule(dynamic, 1)
+    for (int p = 0; p < num_pieces; ++p) {
+      Piece& result = out[p];
+      try {
+        // The piece as a mesh of its own.
+        std::vector<int> local(V->rows(), -1), input;
+        Eigen::MatrixXi Fp(faces_of[p].size(), 3);
+        for (size_t i = 0; i < faces_of[p].size(); ++i) {
+          for (int k = 0; k < 3; ++k) {
+            const int v = (*F)(faces_of[p][i], k);
+            if (local[v] < 0) {
+              local[v] = static_cast<int>(input.size());
+              input.push_back(v);
+            }
+            Fp(i, k) = local[v];
+          }
+        }
+        Eigen::MatrixXd Vp(input.size(), 3);
+        for (size_t i = 0; i < input.size(); ++i) Vp.row(i) = V->row(input[i]);
+        // A cut can leave a vertex of the piece with two fans of faces: one
+        // copy each, on the cut like the vertex, joined again below.
+        SplitPinchedVertices(&Vp, &Fp);
+        Mesh mesh;
+        try {
+          mesh = ToCgal(Vp, Fp, "Decimate");
+        } catch (const InputError&) {
+          result.manifold = false;
+          continue;
+        }
+        // The cut vertices (found by position: the copies too) stay, with
+        // the triangles around them.
+        auto fixed = mesh.add_property_map<Mesh::Vertex_index, bool>("v:mr_cut", false).first;
+        int cut_vertices = 0;
+        for (int v = 0; v < Vp.rows(); ++v) {
+          const bool cut = cut_at.count({Vp(v, 0), Vp(v, 1), Vp(v, 2)}) > 0;
+          fixed[Mesh::Vertex_index(v)] = cut;
+          cut_vertices += cut;
+        }
+        const int target = std::max(4, static_cast<int>(std::lround(share * Fp.rows())));
+        result.collapsed = DecimateMesh(&mesh, target, options, &fixed);
+        FromCgal(mesh, &result.V, &result.F);
+        result.input.assign(result.V.rows(), -1);
+        int found = 0;
+        for (int v = 0; v < result.V.rows(); ++v) {
+          const auto it = cut_at.find({result.V(v, 0), result.V(v, 1), result.V(v, 2)});
+          if (it == cut_at.end()) continue;
+          result.input[v] = it->second;
+          ++found;
+        }
+        MR_CHECK_EQ(found, cut_vertices) << "Decimate: a vertex on a cut moved";
+      } catch (...) {
+        result.error = std::current_exception();
+      }
+    }
+  }  // omp parallel
+  for (const Piece& p : out) {
+    if (p.error) std::rethrow_exception(p.error);
+  }
+  const long not_manifold = std::count_if(out.begin(), out.end(), [](const Piece& p) { return !p.manifold; });
+  if (not_manifold > 0) {
+    MR_LOG(INFO) << "Decimate: " << not_manifold << " of " << num_pieces
+                 << " spatial pieces are not 2-manifolds by themselves; decimating the mesh "
+                    "as a whole";
+    return false;
+  }
+  // Join: one row per cut vertex, shared by its pieces.
+  int rows = 0, faces = 0;
+  for (const Piece& p : out) {
+    rows += static_cast<int>(p.V.rows());
+    faces += static_cast<int>(p.F.rows());
+  }
+  std::vector<int> joined(V->rows(), -1);
+  Eigen::MatrixXd Vj(rows, 3);
+  Eigen::MatrixXi Fj(faces, 3);
+  int nv = 0, nf = 0;
+  for (const Piece& p : out) {
+    std::vector<int> index(p.V.rows());
+    for (int v = 0; v < p.V.rows(); ++v) {
+      const int r = p.input[v];
+      if (r >= 0 && joined[r] >= 0) {
+        index[v] = joined[r];
+        continue;
+      }
+      Vj.row(nv) = p.V.row(v);
+      index[v] = nv;
+      if (r >= 0) joined[r] = nv;
+      ++nv;
+    }
+    for (int f = 0; f < p.F.rows(); ++f, ++nf) {
+      for (int k = 0; k < 3; ++k) Fj(nf, k) = index[p.F(f, k)];
+    }
+    summary->collapsed_edges += p.collapsed;
+  }
+  Vj.conservativeResize(nv, 3);
+  *V = std::move(Vj);
+  *F = std::move(Fj);
+  summary->pieces = num_pieces;
+  summary->threads = threads;
+  return true;
+}
+
+}  // namespace
 
 DecimateSummary Decimate(Eigen::MatrixXd* V, Eigen::MatrixXi* F, int target_faces,
                          const DecimateOptions& options) {
@@ -164,26 +415,22 @@ DecimateSummary Decimate(Eigen::MatrixXd* V, Eigen::MatrixXi* F, int target_face
                  << ", nothing to do";
     return summary;
   }
-  Mesh mesh = ToCgal(*V, *F, "Decimate");
-  RunCgal("Decimate", [&] {
-    if (options.policy == "garland_heckbert") {
-      const SMS::GarlandHeckbert_plane_policies<Mesh, Kernel> gh(mesh);
-      summary.collapsed_edges =
-          CollapseEdges(&mesh, target_faces, gh.get_cost(), gh.get_placement(),
-                        options.bounded_normal_change, options.cancel);
-    } else {
-      summary.collapsed_edges =
-          CollapseEdges(&mesh, target_faces, SMS::LindstromTurk_cost<Mesh>(),
-                        SMS::LindstromTurk_placement<Mesh>(), options.bounded_normal_change,
-                        options.cancel);
-    }
-  });
-  mesh.collect_garbage();
-  FromCgal(mesh, V, F);
+  // A non-manifold input fails here as it does in one piece.
+  const bool in_pieces = options.faces_per_piece > 0 && F->rows() > options.faces_per_piece &&
+                         (ToCgal(*V, *F, "Decimate"), true) &&
+                         DecimateInPieces(V, F, target_faces, options, &summary);
+  if (!in_pieces) {
+    Mesh mesh = ToCgal(*V, *F, "Decimate");
+    summary.collapsed_edges = DecimateMesh(&mesh, target_faces, options, nullptr);
+    FromCgal(mesh, V, F);
+  }
   summary.final_vertices = V->rows();
   summary.final_faces = F->rows();
   summary.cancelled = options.cancel != nullptr && options.cancel->load();
-  summary.target_not_reached = F->rows() > target_faces && !summary.cancelled;
+  // Pieces each stop at their share of the target, rounded: the whole may
+  // end up to half a face per piece above it.
+  summary.target_not_reached =
+      F->rows() > target_faces + summary.pieces - 1 && !summary.cancelled;
   summary.seconds = ElapsedSeconds() - t0;
   if (summary.cancelled) {
     MR_LOG(VERBOSE) << "Decimate: " << summary.BriefReport();

@@ -44,6 +44,15 @@ struct DecimateOptions {
   // `cancelled`. For a decimation run on another thread whose result may
   // turn out not to be needed.
   const std::atomic<bool>* cancel = nullptr;
+  // > 0: a mesh of more faces than this is cut into spatial pieces of at
+  // most about this many faces (median cuts of the face centroids along the
+  // longest side, a power of two of pieces), which are decimated on parallel
+  // threads, each to its share of the target, with every edge along a cut
+  // kept as it is; the pieces are then joined. The result depends on this
+  // number, not on the number of threads. The cuts stay at the input's
+  // resolution, so follow it with a remeshing that may change them
+  // (IsotropicRemesh). 0: the whole mesh at once, on one thread.
+  int faces_per_piece = 0;
 
   bool Check() const;
 };
@@ -52,6 +61,8 @@ struct DecimateSummary {
   int initial_vertices = 0, initial_faces = 0;
   int final_vertices = 0, final_faces = 0;
   int collapsed_edges = 0;
+  int pieces = 1;   // spatial pieces decimated in parallel (faces_per_piece)
+  int threads = 1;  // threads they ran on
   std::string policy;  // the policy actually used
   double seconds = 0;
   // True when the target was not reached (the filter/topology blocked collapses).
@@ -198,6 +209,12 @@ struct CleanMeshReport {
 // CheckMeshInput), never crashes on degenerate geometry.
 CleanMeshReport CleanMesh(Eigen::MatrixXd* V, Eigen::MatrixXi* F,
                           const CleanMeshOptions& options = CleanMeshOptions());
+
+// Gives every extra fan of faces around a pinched vertex (a vertex whose
+// faces, joined through the edges they share, form more than one fan) a copy
+// of the vertex of its own, appended to V. Returns the number of copies.
+// Needs no edge in more than two faces. In place.
+int SplitPinchedVertices(Eigen::MatrixXd* V, Eigen::MatrixXi* F);
 
 // ---------------------------------------------------------------------------
 // Self-intersections.

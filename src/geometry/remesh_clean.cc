@@ -174,6 +174,13 @@ int CountInconsistentEdges(const Eigen::MatrixXi& F, const EdgeTopology& topo) {
 
 }  // namespace
 
+int SplitPinchedVertices(Eigen::MatrixXd* V, Eigen::MatrixXi* F) {
+  MR_CHECK(V != nullptr && F != nullptr);
+  int copies = 0;
+  ProcessVertexFans(ComputeEdgeTopology(*F, V->rows()), V, F, true, &copies);
+  return copies;
+}
+
 void CheckMeshInput(const Eigen::MatrixXd& V, const Eigen::MatrixXi& F, const std::string& what) {
   if (V.rows() > 0 && V.cols() != 3) {
     MR_THROW_INPUT << what << ": V has " << V.cols() << " columns (expected 3)";

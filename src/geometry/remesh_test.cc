@@ -10,6 +10,12 @@
 #include <limits>
 #include <random>
 
+#ifdef _OPENMP
+#include <omp.h>
+#endif
+
+#include <Eigen/Geometry>
+
 #include "geometry/mesh.h"
 #include "util/error.h"
 
@@ -137,6 +143,99 @@ TEST(Decimate, CancelStopsTheCollapses) {
   EXPECT_FALSE(set.target_not_reached);
   EXPECT_EQ(set.collapsed_edges, 0);
   EXPECT_EQ(F.rows(), 5120);
+}
+
+// Decimation on spatial pieces: the pieces join into one closed manifold at
+// the target, as close to the sphere as one piece, and the result is the
+// same on any number of threads (it depends on faces_per_piece only).
+TEST(Decimate, InPiecesJoinsAClosedManifoldIndependentOfThreads) {
+  Eigen::MatrixXd V0;
+  Eigen::MatrixXi F0;
+  Icosphere(5, &V0, &F0);  // 20480 faces
+  const int target = 8000;  // the refiner's reductions: 2-3x
+  DecimateOptions options;
+  options.faces_per_piece = 6000;  // 20480 / 4 = 5120 per piece
+  Eigen::MatrixXd V = V0;
+  Eigen::MatrixXi F = F0;
+  const DecimateSummary s = Decimate(&V, &F, target, options);
+  EXPECT_EQ(s.pieces, 4);
+  EXPECT_FALSE(s.target_not_reached);
+  EXPECT_LE(F.rows(), target + s.pieces - 1);
+  EXPECT_GE(F.rows(), target - s.pieces);
+  EXPECT_EQ(s.final_faces, F.rows());
+  EXPECT_EQ(s.final_vertices, V.rows());
+  // One closed 2-manifold: the cuts were joined (a cut vertex left twice
+  // would leave border edges), with the Euler characteristic of a sphere.
+  EXPECT_TRUE(IsClosedManifold(V, F));
+  EXPECT_EQ(V.rows() - F.rows() / 2, 2);
+  // As close to the sphere as the whole mesh decimated at once (1 %), and
+  // no face turned (the triangles next to the kept cuts included).
+  EXPECT_LT(MaxRadiusError(V), 0.01);
+  EXPECT_LT(MaxCentroidRadiusError(V, F), 0.01);
+  const Eigen::MatrixXd N = FaceNormals(V, F);
+  for (int f = 0; f < F.rows(); ++f) {
+    ASSERT_GT(N.row(f).dot(FaceCentroid(V, F, f).normalized()), 0.5) << "face " << f;
+  }
+#ifdef _OPENMP
+  const int threads = omp_get_max_threads();
+  for (const int n : {1, 3}) {
+    omp_set_num_threads(n);
+    Eigen::MatrixXd Vn = V0;
+    Eigen::MatrixXi Fn = F0;
+    const DecimateSummary sn = Decimate(&Vn, &Fn, target, options);
+    EXPECT_EQ(sn.threads, n);
+    EXPECT_EQ(Vn, V) << n << " threads";
+    EXPECT_EQ(Fn, F) << n << " threads";
+  }
+  omp_set_num_threads(threads);
+#endif
+}
+
+// The vertices on the cuts keep their input positions bit for bit (the pieces
+// are joined at them); those away from the cuts are decimated as usual.
+TEST(Decimate, InPiecesKeepsTheCutVertices) {
+  Eigen::MatrixXd V0;
+  Eigen::MatrixXi F0;
+  Icosphere(4, &V0, &F0);  // 5120 faces
+  // Turned off the icosahedron's symmetry planes, so that no two centroids
+  // tie at the median and the test's cut is the function's.
+  V0 = V0 * Eigen::Matrix3d(Eigen::AngleAxisd(0.3, Eigen::Vector3d(1, 2, 3).normalized()));
+  DecimateOptions options;
+  options.faces_per_piece = 2560;  // two pieces: one cut
+  Eigen::MatrixXd V = V0;
+  Eigen::MatrixXi F = F0;
+  const DecimateSummary s = Decimate(&V, &F, 2000, options);
+  ASSERT_EQ(s.pieces, 2);
+  // The input vertices shared by faces on both sides of the median cut.
+  Eigen::MatrixXd C(F0.rows(), 3);
+  for (int f = 0; f < F0.rows(); ++f) C.row(f) = FaceCentroid(V0, F0, f);
+  int axis = 0;
+  (C.colwise().maxCoeff() - C.colwise().minCoeff()).maxCoeff(&axis);
+  std::vector<double> along(C.rows());
+  for (int f = 0; f < C.rows(); ++f) along[f] = C(f, axis);
+  std::vector<double> sorted = along;
+  std::nth_element(sorted.begin(), sorted.begin() + sorted.size() / 2, sorted.end());
+  const double median = sorted[sorted.size() / 2];
+  std::vector<int> side(V0.rows(), 0);  // bit 1: a face below, bit 2: a face at or above
+  for (int f = 0; f < F0.rows(); ++f) {
+    for (int k = 0; k < 3; ++k) side[F0(f, k)] |= along[f] < median ? 1 : 2;
+  }
+  int cut = 0, kept = 0;
+  for (int v = 0; v < V0.rows(); ++v) {
+    if (side[v] != 3) continue;
+    ++cut;
+    for (int w = 0; w < V.rows(); ++w) {
+      if (V.row(w) == V0.row(v)) {
+        ++kept;
+        break;
+      }
+    }
+  }
+  EXPECT_GT(cut, 20);
+  EXPECT_EQ(kept, cut);
+  EXPECT_TRUE(IsClosedManifold(V, F));
+  // 5120 -> 2000 faces: about 1000 vertices of 2562 left.
+  EXPECT_LT(V.rows(), 1010);
 }
 
 TEST(Decimate, BelowTargetIsUnchanged) {

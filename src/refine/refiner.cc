@@ -129,6 +129,10 @@ void RefineCamerasAtLevel(const RefineOptions& options,
   }
 }
 
+// Faces per spatial piece of the remeshing's first decimation (the example's
+// 303k-face Poisson mesh: 8 pieces; docs/results.md, "Speed and memory").
+constexpr int kDecimateFacesPerPiece = 50000;
+
 // Remeshes to the level's target edge length, within the face budget.
 // Returns false, leaving (V, F) half-done, when *cancel (if given) was set
 // before the end; it is checked during the decimation and between stages.
@@ -143,9 +147,13 @@ bool RemeshForLevel(const std::vector<PinholeView>& views, const RefineOptions& 
   const int faces_before = static_cast<int>(F->rows());
   if (faces_before > 2 * target_faces) {
     // Large reductions by quadric decimation first (Garland-Heckbert), which
-    // keeps the shape better than collapsing to length alone.
+    // keeps the shape better than collapsing to length alone. On spatial
+    // pieces in parallel (their cuts, left at the input's resolution, are
+    // remeshed below); the pieces follow from the face count alone, so the
+    // result does not depend on the number of threads.
     DecimateOptions decimate;
     decimate.cancel = cancel;
+    decimate.faces_per_piece = kDecimateFacesPerPiece;
     const DecimateSummary decimated = Decimate(V, F, std::max(4, target_faces), decimate);
     MR_LOG(VERBOSE) << decimated.BriefReport();
   }
