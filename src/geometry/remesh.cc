@@ -231,16 +231,17 @@ int DecimateMesh(Mesh* mesh, int target, const DecimateOptions& options,
 
 // The spatial piece of every face: the faces' centroids cut at their median
 // along the longest side of their box, again and again, until no piece has
-// more than `max_faces` faces (2^k pieces). Sets *num_pieces.
+// more than `max_faces` faces or there are `max_pieces` pieces (2^k pieces,
+// k >= 0). Sets *num_pieces.
 std::vector<int> SpatialPieces(const Eigen::MatrixXd& V, const Eigen::MatrixXi& F, int max_faces,
-                               int* num_pieces) {
+                               int max_pieces, int* num_pieces) {
   const int n = static_cast<int>(F.rows());
   std::vector<Eigen::Vector3d> centroid(n);
   for (int f = 0; f < n; ++f) centroid[f] = FaceCentroid(V, F, f);
   std::vector<int> order(n);
   for (int f = 0; f < n; ++f) order[f] = f;
   int pieces = 1;
-  while (n / pieces > max_faces && pieces < (1 << 12)) pieces *= 2;
+  while (n / pieces > max_faces && 2 * pieces <= max_pieces) pieces *= 2;
   // Piece p holds order[bounds[p], bounds[p + 1]); each round halves all.
   std::vector<int> bounds = {0, n};
   while (static_cast<int>(bounds.size()) - 1 < pieces) {
@@ -272,14 +273,22 @@ std::vector<int> SpatialPieces(const Eigen::MatrixXd& V, const Eigen::MatrixXi& 
 // is decimated on a thread of its own to its share of the target, leaving
 // the vertices on its cuts and the triangles around them as they are; the
 // pieces are then joined at those vertices, by their (unchanged) positions.
-// Returns false, leaving (V, F) as they were, when a piece is not a
-// 2-manifold by itself even with its pinched vertices split, or a cut vertex
-// shares its position with another vertex; the caller then decimates the
-// whole.
+// Returns false, leaving (V, F) as they were, when the target is too small
+// for two pieces, a piece is not a 2-manifold by itself even with its
+// pinched vertices split, or a cut vertex shares its position with another
+// vertex; the caller then decimates the whole.
 bool DecimateInPieces(Eigen::MatrixXd* V, Eigen::MatrixXi* F, int target_faces,
                       const DecimateOptions& options, DecimateSummary* summary) {
   int num_pieces = 1;
-  const std::vector<int> piece = SpatialPieces(*V, *F, options.faces_per_piece, &num_pieces);
+  // No piece is decimated below kMinPieceTarget faces: the faces kept along
+  // its cuts would be too large a share of it, and the rest of it would be
+  // decimated the harder (a hull's coarse level; a 20k-face sphere cut into 8
+  // pieces and decimated to 2,000 faces turned faces on edge).
+  constexpr int kMinPieceTarget = 8000;
+  const std::vector<int> piece = SpatialPieces(*V, *F, options.faces_per_piece,
+                                               std::max(1, target_faces / kMinPieceTarget),
+                                               &num_pieces);
+  if (num_pieces < 2) return false;
   // A vertex is on a cut when its faces lie in more than one piece.
   std::vector<int> first_piece(V->rows(), -1);
   std::vector<char> on_cut(V->rows(), 0);

@@ -46,9 +46,11 @@ struct DecimateOptions {
   const std::atomic<bool>* cancel = nullptr;
   // > 0: a mesh of more faces than this is cut into spatial pieces of at
   // most about this many faces (median cuts of the face centroids along the
-  // longest side, a power of two of pieces), which are decimated on parallel
-  // threads, each to its share of the target, with every edge along a cut
-  // kept as it is; the pieces are then joined. The result depends on this
+  // longest side, a power of two of pieces, and no more than leave each
+  // piece 8,000 faces of the target), which are decimated on parallel
+  // threads, each to its share of the target, with the vertices on the cuts
+  // and the triangles around them kept as they are; the pieces are then
+  // joined. The result depends on this
   // number, not on the number of threads. The cuts stay at the input's
   // resolution, so follow it with a remeshing that may change them
   // (IsotropicRemesh). 0: the whole mesh at once, on one thread.

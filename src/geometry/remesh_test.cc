@@ -151,10 +151,10 @@ TEST(Decimate, CancelStopsTheCollapses) {
 TEST(Decimate, InPiecesJoinsAClosedManifoldIndependentOfThreads) {
   Eigen::MatrixXd V0;
   Eigen::MatrixXi F0;
-  Icosphere(5, &V0, &F0);  // 20480 faces
-  const int target = 8000;  // the refiner's reductions: 2-3x
+  Icosphere(6, &V0, &F0);  // 81920 faces
+  const int target = 32000;  // the refiner's reductions: 2-3x; 8000 per piece
   DecimateOptions options;
-  options.faces_per_piece = 6000;  // 20480 / 4 = 5120 per piece
+  options.faces_per_piece = 25000;  // 81920 / 4 = 20480 per piece
   Eigen::MatrixXd V = V0;
   Eigen::MatrixXi F = F0;
   const DecimateSummary s = Decimate(&V, &F, target, options);
@@ -196,15 +196,15 @@ TEST(Decimate, InPiecesJoinsAClosedManifoldIndependentOfThreads) {
 TEST(Decimate, InPiecesKeepsTheCutVertices) {
   Eigen::MatrixXd V0;
   Eigen::MatrixXi F0;
-  Icosphere(4, &V0, &F0);  // 5120 faces
+  Icosphere(6, &V0, &F0);  // 81920 faces
   // Turned off the icosahedron's symmetry planes, so that no two centroids
   // tie at the median and the test's cut is the function's.
   V0 = V0 * Eigen::Matrix3d(Eigen::AngleAxisd(0.3, Eigen::Vector3d(1, 2, 3).normalized()));
   DecimateOptions options;
-  options.faces_per_piece = 2560;  // two pieces: one cut
+  options.faces_per_piece = 41000;  // two pieces: one cut
   Eigen::MatrixXd V = V0;
   Eigen::MatrixXi F = F0;
-  const DecimateSummary s = Decimate(&V, &F, 2000, options);
+  const DecimateSummary s = Decimate(&V, &F, 20000, options);
   ASSERT_EQ(s.pieces, 2);
   // The input vertices shared by faces on both sides of the median cut.
   Eigen::MatrixXd C(F0.rows(), 3);
@@ -234,8 +234,25 @@ TEST(Decimate, InPiecesKeepsTheCutVertices) {
   EXPECT_GT(cut, 20);
   EXPECT_EQ(kept, cut);
   EXPECT_TRUE(IsClosedManifold(V, F));
-  // 5120 -> 2000 faces: about 1000 vertices of 2562 left.
-  EXPECT_LT(V.rows(), 1010);
+  // 81920 -> 20000 faces: about 10000 vertices of 40962 left.
+  EXPECT_LT(V.rows(), 10010);
+}
+
+// A target too small to leave each piece 8,000 faces is decimated as a
+// whole: the faces kept along the cuts would crowd the pieces (8 pieces of a
+// 20k-face sphere decimated to 2,000 faces turned faces on edge).
+TEST(Decimate, SmallTargetIsDecimatedWhole) {
+  Eigen::MatrixXd V, V1;
+  Eigen::MatrixXi F, F1;
+  Icosphere(5, &V, &F);  // 20480 faces
+  V1 = V;
+  F1 = F;
+  DecimateOptions options;
+  options.faces_per_piece = 3000;
+  EXPECT_EQ(Decimate(&V, &F, 2000, options).pieces, 1);
+  Decimate(&V1, &F1, 2000);
+  EXPECT_EQ(V, V1);
+  EXPECT_EQ(F, F1);
 }
 
 TEST(Decimate, BelowTargetIsUnchanged) {
