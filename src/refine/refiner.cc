@@ -172,7 +172,11 @@ bool RemeshForLevel(const std::vector<PinholeView>& views, const RefineOptions& 
   // budget is enforced by a last, small quadric decimation.
   if (cancelled()) return false;
   if (F->rows() > max_faces) {
-    const DecimateSummary trimmed = Decimate(V, F, max_faces);
+    // On pieces too: the triangles kept along the cuts are the remeshed
+    // ones, already at the working length.
+    DecimateOptions trim;
+    trim.faces_per_piece = kDecimateFacesPerPiece;
+    const DecimateSummary trimmed = Decimate(V, F, max_faces, trim);
     MR_LOG(INFO) << "Remeshed mesh over the face budget (max_faces " << max_faces
                  << "): " << trimmed.BriefReport();
   }
