@@ -457,12 +457,12 @@ DecimateSummary Decimate(Eigen::MatrixXd* V, Eigen::MatrixXi* F, int target_face
                  << ", nothing to do";
     return summary;
   }
-  // A non-manifold input fails here as it does in one piece.
+  // Converted first, also for pieces: a non-manifold input fails alike, and
+  // the mesh serves when the pieces do not.
+  Mesh mesh = ToCgal(*V, *F, "Decimate");
   const bool in_pieces = options.faces_per_piece > 0 && F->rows() > options.faces_per_piece &&
-                         (ToCgal(*V, *F, "Decimate"), true) &&
                          DecimateInPieces(V, F, target_faces, options, &summary);
   if (!in_pieces) {
-    Mesh mesh = ToCgal(*V, *F, "Decimate");
     summary.collapsed_edges = DecimateMesh(&mesh, target_faces, options, nullptr);
     FromCgal(mesh, V, F);
   }

@@ -129,8 +129,9 @@ void RefineCamerasAtLevel(const RefineOptions& options,
   }
 }
 
-// Faces per spatial piece of the remeshing's first decimation (the example's
-// 303k-face Poisson mesh: 8 pieces; docs/results.md, "Speed and memory").
+// Faces per spatial piece of the remeshing's decimations, the first one and
+// the trim to the face budget (the example's 303k-face Poisson mesh: 8
+// pieces; docs/results.md, "Speed and memory").
 constexpr int kDecimateFacesPerPiece = 50000;
 
 // Remeshes to the level's target edge length, within the face budget.
