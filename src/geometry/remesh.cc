@@ -16,8 +16,6 @@
 
 #include <Eigen/Geometry>
 
-#include <CGAL/Bbox_3.h>
-#include <CGAL/box_intersection_d.h>
 #include <CGAL/Exact_predicates_inexact_constructions_kernel.h>
 #include <CGAL/Surface_mesh.h>
 #include <CGAL/exceptions.h>
@@ -27,7 +25,6 @@
 #include <CGAL/Polygon_mesh_processing/polygon_soup_to_polygon_mesh.h>
 #include <CGAL/Polygon_mesh_processing/remesh.h>
 #include <CGAL/Polygon_mesh_processing/repair_self_intersections.h>
-#include <CGAL/Polygon_mesh_processing/self_intersections.h>
 #include <CGAL/Surface_mesh_simplification/Policies/Edge_collapse/Bounded_normal_change_filter.h>
 #include <CGAL/Surface_mesh_simplification/Policies/Edge_collapse/GarlandHeckbert_plane_policies.h>
 #include <CGAL/Surface_mesh_simplification/Policies/Edge_collapse/LindstromTurk_cost.h>
@@ -40,6 +37,7 @@
 #endif
 
 #include "geometry/mesh.h"
+#include "geometry/self_intersection.h"
 #include "util/error.h"
 #include "util/logging.h"
 
@@ -679,45 +677,17 @@ std::string SelfIntersectionReport::BriefReport() const {
   return s.str();
 }
 
-namespace {
-
-// The intersecting face pairs (a < b, sorted) among the faces of `range`
-// (CGAL's test; a fresh mesh from ToCgal, so face index == row of F).
-std::vector<std::pair<int, int>> IntersectingPairs(const Mesh& mesh,
-                                                   const std::vector<Mesh::Face_index>& range,
-                                                   const char* what) {
-  std::vector<std::pair<Mesh::Face_index, Mesh::Face_index>> found;
-  RunCgal(what, [&] {
-    PMP::self_intersections<CGAL::Parallel_if_available_tag>(range, mesh,
-                                                             std::back_inserter(found));
-  });
-  std::vector<std::pair<int, int>> pairs;
-  pairs.reserve(found.size());
-  for (const auto& p : found) {
-    const int a = static_cast<int>(p.first.idx()), b = static_cast<int>(p.second.idx());
-    pairs.emplace_back(std::min(a, b), std::max(a, b));
-  }
-  std::sort(pairs.begin(), pairs.end());
-  return pairs;
-}
-
-// The same over the whole mesh.
-std::vector<std::pair<int, int>> IntersectingPairs(const Mesh& mesh, const char* what) {
-  const auto all = faces(mesh);
-  return IntersectingPairs(mesh, std::vector<Mesh::Face_index>(all.begin(), all.end()), what);
-}
-
-}  // namespace
-
 SelfIntersectionReport CountSelfIntersections(const Eigen::MatrixXd& V, const Eigen::MatrixXi& F,
                                               bool keep_pairs) {
   CheckMeshInput(V, F, "CountSelfIntersections");
   const double t0 = ElapsedSeconds();
   SelfIntersectionReport report;
-  report.parallel = std::is_same<CGAL::Parallel_if_available_tag, CGAL::Parallel_tag>::value;
+#ifdef _OPENMP
+  report.parallel = omp_get_max_threads() > 1;
+#endif
   if (F.rows() == 0) return report;
-  std::vector<std::pair<int, int>> pairs =
-      IntersectingPairs(ToCgal(V, F, "CountSelfIntersections"), "CountSelfIntersections");
+  ToCgal(V, F, "CountSelfIntersections");  // throws unless an oriented 2-manifold
+  std::vector<std::pair<int, int>> pairs = IntersectingFacePairs(V, F);
   report.intersecting_pairs = static_cast<long>(pairs.size());
   std::vector<int> involved;
   involved.reserve(2 * pairs.size());
@@ -821,39 +791,6 @@ RemoveSelfIntersectionsSummary RemoveSelfIntersections(
   return summary;
 }
 
-namespace {
-
-// The range that holds every pair involving a face of `faces`: those faces
-// and every face whose bounding box overlaps one of theirs
-// (box_intersection_d), so the rest of the mesh is skipped.
-std::vector<Mesh::Face_index> FacesNear(const Eigen::MatrixXd& V, const Eigen::MatrixXi& F,
-                                        const std::vector<int>& faces) {
-  using Box = CGAL::Box_intersection_d::Box_with_info_d<double, 3, int>;
-  auto face_box = [&](int f) {
-    CGAL::Bbox_3 b;
-    for (int k = 0; k < 3; ++k) {
-      const Eigen::Vector3d p = V.row(F(f, k));
-      b += CGAL::Bbox_3(p.x(), p.y(), p.z(), p.x(), p.y(), p.z());
-    }
-    return Box(b, f);
-  };
-  std::vector<Box> queries, all;
-  for (int f : faces) queries.push_back(face_box(f));
-  all.reserve(F.rows());
-  for (int f = 0; f < F.rows(); ++f) all.push_back(face_box(f));
-  std::vector<char> in_range(F.rows(), 0);
-  for (int f : faces) in_range[f] = 1;
-  CGAL::box_intersection_d(queries.begin(), queries.end(), all.begin(), all.end(),
-                           [&](const Box&, const Box& b) { in_range[b.info()] = 1; });
-  std::vector<Mesh::Face_index> range;
-  for (int f = 0; f < F.rows(); ++f) {
-    if (in_range[f]) range.push_back(Mesh::Face_index(f));
-  }
-  return range;
-}
-
-}  // namespace
-
 std::string UndoSelfIntersectionsSummary::BriefReport() const {
   std::ostringstream s;
   s << "new intersecting pairs " << initial_pairs << " undone by resetting " << reset_vertices
@@ -877,29 +814,90 @@ void CheckUndoInput(const Eigen::MatrixXd& V_before, const Eigen::MatrixXi& F,
   MR_CHECK(std::is_sorted(allowed.begin(), allowed.end()));
 }
 
-// The loop of UndoSelfIntersections on `mesh`, a CGAL mesh of F (face index
-// == row of F) whose points are overwritten with *V_after first.
+// The candidate face pairs of every check of UndoSelfIntersections: each
+// vertex is at its V_before or its V_after position in every check, so a
+// face's box in any check lies within the union of its boxes at V_before and
+// at V_after, and only pairs whose unions overlap can intersect. Found once
+// per call; the later rounds look up the candidates of the faces they
+// changed.
+struct PairCandidates {
+  std::vector<std::pair<int, int>> pairs;
+  std::vector<int> start, of_face;  // the candidates of face f: of_face[start[f] .. start[f + 1])
+
+  PairCandidates(const Eigen::MatrixXd& V_before, const Eigen::MatrixXd& V_after,
+                 const Eigen::MatrixXi& F) {
+    Boxes boxes = FaceBoxes(V_before, F);
+    const Boxes after = FaceBoxes(V_after, F);
+    boxes.lo = boxes.lo.cwiseMin(after.lo);
+    boxes.hi = boxes.hi.cwiseMax(after.hi);
+    std::vector<int> all(F.rows());
+    for (int f = 0; f < F.rows(); ++f) all[f] = f;
+    pairs = OverlappingBoxes(boxes, all);
+    start.assign(F.rows() + 1, 0);
+    for (const auto& [a, b] : pairs) {
+      ++start[a + 1];
+      ++start[b + 1];
+    }
+    for (int f = 0; f < F.rows(); ++f) start[f + 1] += start[f];
+    of_face.resize(2 * pairs.size());
+    std::vector<int> next(start.begin(), start.end() - 1);
+    for (int i = 0; i < static_cast<int>(pairs.size()); ++i) {
+      of_face[next[pairs[i].first]++] = i;
+      of_face[next[pairs[i].second]++] = i;
+    }
+  }
+};
+
+// The loop of UndoSelfIntersections.
 UndoSelfIntersectionsSummary UndoOnMesh(const Eigen::MatrixXd& V_before, const Eigen::MatrixXi& F,
                                         const std::vector<std::pair<int, int>>& allowed,
-                                        Mesh* mesh_ptr, Eigen::MatrixXd* V_after) {
-  Mesh& mesh = *mesh_ptr;
-  MR_CHECK_EQ(static_cast<long>(mesh.number_of_vertices()), static_cast<long>(V_after->rows()));
-  MR_CHECK_EQ(static_cast<long>(mesh.number_of_faces()), static_cast<long>(F.rows()));
-  for (int v = 0; v < V_after->rows(); ++v) {
-    mesh.point(Mesh::Vertex_index(v)) = Point((*V_after)(v, 0), (*V_after)(v, 1), (*V_after)(v, 2));
-  }
+                                        Eigen::MatrixXd* V_after) {
   const double t0 = ElapsedSeconds();
   UndoSelfIntersectionsSummary summary;
+  const PairCandidates candidates(V_before, *V_after, F);
+  const int num_faces = static_cast<int>(F.rows());
+  Boxes boxes = FaceBoxes(*V_after, F);
+  std::vector<char> degenerate(num_faces, 0);
+#pragma omp parallel for schedule(static)
+  for (int f = 0; f < num_faces; ++f) degenerate[f] = FaceIsDegenerate(*V_after, F, f) ? 1 : 0;
+
   std::vector<char> reset(V_after->rows(), 0);
-  // Faces with a vertex reset in the last round: after the first (whole
-  // mesh) check, new pairs can only involve these.
+  // After the first (whole-mesh) check, new pairs can only involve faces
+  // with a vertex reset in the last round: their candidates are checked.
   std::vector<int> changed_faces;
   std::vector<std::vector<int>> vertex_faces;
+  std::vector<int> to_check;  // candidate indices
+  std::vector<char> hit;
   for (bool first = true;; first = false) {
-    const std::vector<std::pair<int, int>> pairs =
-        first ? IntersectingPairs(mesh, "UndoSelfIntersections")
-              : IntersectingPairs(mesh, FacesNear(*V_after, F, changed_faces),
-                                  "UndoSelfIntersections");
+    std::vector<std::pair<int, int>> pairs;
+    if (first) {
+      to_check.resize(candidates.pairs.size());
+      for (size_t i = 0; i < to_check.size(); ++i) to_check[i] = static_cast<int>(i);
+      for (int f = 0; f < num_faces; ++f) {
+        if (degenerate[f]) pairs.emplace_back(f, f);
+      }
+    } else {
+      to_check.clear();
+      for (const int f : changed_faces) {
+        if (degenerate[f]) pairs.emplace_back(f, f);
+        to_check.insert(to_check.end(), candidates.of_face.begin() + candidates.start[f],
+                        candidates.of_face.begin() + candidates.start[f + 1]);
+      }
+      std::sort(to_check.begin(), to_check.end());
+      to_check.erase(std::unique(to_check.begin(), to_check.end()), to_check.end());
+    }
+    hit.assign(to_check.size(), 0);
+    const long num_checks = static_cast<long>(to_check.size());
+#pragma omp parallel for schedule(dynamic, 1024)
+    for (long i = 0; i < num_checks; ++i) {
+      const auto [a, b] = candidates.pairs[to_check[i]];
+      hit[i] = !degenerate[a] && !degenerate[b] && BoxesOverlap(boxes, a, boxes, b) &&
+               FacesIntersect(*V_after, F, a, b);
+    }
+    for (long i = 0; i < num_checks; ++i) {
+      if (hit[i]) pairs.push_back(candidates.pairs[to_check[i]]);
+    }
+    std::sort(pairs.begin(), pairs.end());
     std::vector<int> offending;  // faces of new pairs, then flipped faces
     long new_pairs = 0;
     for (const auto& p : pairs) {
@@ -916,7 +914,7 @@ UndoSelfIntersectionsSummary UndoOnMesh(const Eigen::MatrixXd& V_before, const E
     ++summary.rounds;
     if (vertex_faces.empty()) {
       vertex_faces.resize(V_after->rows());
-      for (int f = 0; f < F.rows(); ++f) {
+      for (int f = 0; f < num_faces; ++f) {
         for (int k = 0; k < 3; ++k) vertex_faces[F(f, k)].push_back(f);
       }
     }
@@ -928,7 +926,6 @@ UndoSelfIntersectionsSummary UndoOnMesh(const Eigen::MatrixXd& V_before, const E
         if (reset[v]) continue;
         reset[v] = 1;
         V_after->row(v) = V_before.row(v);
-        mesh.point(Mesh::Vertex_index(v)) = Point(V_before(v, 0), V_before(v, 1), V_before(v, 2));
         ++newly_reset;
         changed_faces.insert(changed_faces.end(), vertex_faces[v].begin(), vertex_faces[v].end());
       }
@@ -936,6 +933,15 @@ UndoSelfIntersectionsSummary UndoOnMesh(const Eigen::MatrixXd& V_before, const E
     std::sort(changed_faces.begin(), changed_faces.end());
     changed_faces.erase(std::unique(changed_faces.begin(), changed_faces.end()),
                         changed_faces.end());
+    for (const int f : changed_faces) {
+      for (int k = 0; k < 3; ++k) {
+        const double x = (*V_after)(F(f, 0), k), y = (*V_after)(F(f, 1), k),
+                     z = (*V_after)(F(f, 2), k);
+        boxes.lo(f, k) = std::min({x, y, z});
+        boxes.hi(f, k) = std::max({x, y, z});
+      }
+      degenerate[f] = FaceIsDegenerate(*V_after, F, f) ? 1 : 0;
+    }
     summary.reset_vertices += newly_reset;
     // Cannot happen when V_before has no pair outside `allowed` (see the
     // header); then the offending pairs were already in V_before.
@@ -956,22 +962,21 @@ UndoSelfIntersectionsSummary UndoSelfIntersections(
     const Eigen::MatrixXd& V_before, const Eigen::MatrixXi& F,
     const std::vector<std::pair<int, int>>& allowed, Eigen::MatrixXd* V_after) {
   CheckUndoInput(V_before, F, allowed, V_after);
-  Mesh mesh = ToCgal(*V_after, F, "UndoSelfIntersections");
-  return UndoOnMesh(V_before, F, allowed, &mesh, V_after);
+  ToCgal(*V_after, F, "UndoSelfIntersections");  // throws unless an oriented 2-manifold
+  return UndoOnMesh(V_before, F, allowed, V_after);
 }
 
 struct SelfIntersectionGuard::Impl {
   Eigen::MatrixXi F;
-  Mesh mesh;  // F's connectivity, built once; points overwritten by every Undo
   std::vector<std::pair<int, int>> allowed;
 };
 
 SelfIntersectionGuard::SelfIntersectionGuard(const Eigen::MatrixXd& V, const Eigen::MatrixXi& F)
     : impl_(new Impl) {
   CheckMeshInput(V, F, "SelfIntersectionGuard");
+  ToCgal(V, F, "SelfIntersectionGuard");  // throws unless an oriented 2-manifold
   impl_->F = F;
-  impl_->mesh = ToCgal(V, F, "SelfIntersectionGuard");
-  impl_->allowed = IntersectingPairs(impl_->mesh, "SelfIntersectionGuard");
+  impl_->allowed = IntersectingFacePairs(V, F);
 }
 
 SelfIntersectionGuard::~SelfIntersectionGuard() = default;
@@ -983,7 +988,7 @@ const std::vector<std::pair<int, int>>& SelfIntersectionGuard::initial_pairs() c
 UndoSelfIntersectionsSummary SelfIntersectionGuard::Undo(const Eigen::MatrixXd& V_before,
                                                          Eigen::MatrixXd* V_after) {
   CheckUndoInput(V_before, impl_->F, impl_->allowed, V_after);
-  return UndoOnMesh(V_before, impl_->F, impl_->allowed, &impl_->mesh, V_after);
+  return UndoOnMesh(V_before, impl_->F, impl_->allowed, V_after);
 }
 
 }  // namespace mr

@@ -225,14 +225,15 @@ struct SelfIntersectionReport {
   long intersecting_pairs = 0;       // pairs of faces that intersect (not adjacent-legal)
   int intersecting_faces = 0;        // distinct faces involved
   std::vector<std::pair<int, int>> pairs;  // face index pairs (if requested)
-  bool parallel = false;             // computed with TBB
+  bool parallel = false;             // computed on more than one thread
   double seconds = 0;
   std::string BriefReport() const;
 };
 
-// Counts self-intersecting face pairs (CGAL PMP::self_intersections, uses
-// TBB when CGAL was built/linked with it). Needs an oriented 2-manifold.
-// `keep_pairs`: also return the pairs.
+// Counts self-intersecting face pairs (IntersectingFacePairs in
+// self_intersection.h: the pairs CGAL's PMP::self_intersections reports, on
+// all OpenMP threads). Needs an oriented 2-manifold. `keep_pairs`: also
+// return the pairs.
 SelfIntersectionReport CountSelfIntersections(const Eigen::MatrixXd& V, const Eigen::MatrixXi& F,
                                               bool keep_pairs = false);
 
@@ -280,17 +281,17 @@ struct UndoSelfIntersectionsSummary {
 // (a partial reset can fold a face), repeated until neither is left. This
 // terminates: a round that finds something resets at least one vertex not
 // yet reset, because a face pair whose six vertices are all back at V_before
-// is a pair of V_before. The first check covers the whole mesh (CGAL), the
-// later ones only the faces around reset vertices and what their bounding
-// boxes overlap. Needs an oriented 2-manifold; V_before and *V_after
-// have the same shape. In place.
+// is a pair of V_before. The candidate pairs are found once per call (the
+// faces whose boxes over both positions of their vertices overlap); the first
+// check tests all of them (IntersectingFacePairs' exact test), the later ones
+// those of the faces around reset vertices. Needs an oriented 2-manifold;
+// V_before and *V_after have the same shape. In place.
 UndoSelfIntersectionsSummary UndoSelfIntersections(
     const Eigen::MatrixXd& V_before, const Eigen::MatrixXi& F,
     const std::vector<std::pair<int, int>>& allowed, Eigen::MatrixXd* V_after);
 
 // UndoSelfIntersections for a loop of motions over one connectivity: the
-// CGAL structure is built once (not per call), and the pairs the mesh has
-// when the guard is made are the allowed ones.
+// pairs the mesh has when the guard is made are the allowed ones.
 class SelfIntersectionGuard {
  public:
   // F must be an oriented 2-manifold (throws InputError otherwise).

@@ -735,7 +735,7 @@ TEST(SelfIntersections, UndoLeavesNoneAfterManyWildMoves) {
 }
 
 TEST(SelfIntersections, GuardEqualsUndoOverManyMotions) {
-  // The guard keeps one CGAL mesh over many calls; each call must give what
+  // The guard serves many calls; each call must give what
   // the stateless function gives with the guard's initial pairs allowed.
   Eigen::MatrixXd V;
   Eigen::MatrixXi F;
