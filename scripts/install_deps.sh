@@ -5,7 +5,7 @@ set -euo pipefail
 PACKAGES=(
   build-essential cmake pkg-config
   libeigen3-dev libceres-dev libcgal-dev libgmp-dev libmpfr-dev libboost-dev
-  libopencv-dev libgtest-dev libtbb-dev
+  libopencv-dev libgtest-dev
   libegl-dev libgl-dev libgles-dev libegl-mesa0 libgl1-mesa-dri
   colmap
   clang libclang-rt-14-dev llvm

@@ -10,11 +10,8 @@
 #include <CGAL/Exact_predicates_inexact_constructions_kernel.h>
 #include <CGAL/intersections.h>
 
-#ifdef _OPENMP
-#include <omp.h>
-#endif
-
 #include "util/error.h"
+#include "util/threads.h"
 
 namespace mr {
 namespace {
@@ -63,22 +60,6 @@ bool FacesIntersectAt(const Point* p, const int va[3], const int vb[3]) {
 }
 
 Point Corner(const Eigen::MatrixXd& V, int v) { return Point(V(v, 0), V(v, 1), V(v, 2)); }
-
-int NumThreads() {
-#ifdef _OPENMP
-  return std::max(1, omp_get_max_threads());
-#else
-  return 1;
-#endif
-}
-
-int ThreadIndex() {
-#ifdef _OPENMP
-  return omp_get_thread_num();
-#else
-  return 0;
-#endif
-}
 
 // Sorts (cell, box) entries by cell, stably (a cell's boxes stay in the order
 // given), cells in [0, num_cells): least significant digit first, 11 bits a

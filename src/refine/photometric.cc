@@ -6,11 +6,8 @@
 #include <opencv2/imgproc.hpp>
 
 #include "refine/pyramid.h"
-
-#ifdef _OPENMP
-#include <omp.h>
-#endif
 #include "util/error.h"
+#include "util/threads.h"
 
 namespace mr {
 namespace {
@@ -181,22 +178,6 @@ void WarpImage(const MeshGeometry& mesh, const PinholeView& view_i, const Render
       footprint->at<double>(r, c) = warp.depth / view_i.fx;
     }
   }
-}
-
-int NumThreads() {
-#ifdef _OPENMP
-  return std::max(1, omp_get_max_threads());
-#else
-  return 1;
-#endif
-}
-
-int ThreadIndex() {
-#ifdef _OPENMP
-  return omp_get_thread_num();
-#else
-  return 0;
-#endif
 }
 
 }  // namespace
