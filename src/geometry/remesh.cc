@@ -827,9 +827,14 @@ struct PairCandidates {
   PairCandidates(const Eigen::MatrixXd& V_before, const Eigen::MatrixXd& V_after,
                  const Eigen::MatrixXi& F) {
     Boxes boxes = FaceBoxes(V_before, F);
-    const Boxes after = FaceBoxes(V_after, F);
-    boxes.lo = boxes.lo.cwiseMin(after.lo);
-    boxes.hi = boxes.hi.cwiseMax(after.hi);
+    for (Eigen::Index f = 0; f < F.rows(); ++f) {
+      for (int c = 0; c < 3; ++c) {
+        for (int k = 0; k < 3; ++k) {
+          boxes.lo(f, k) = std::min(boxes.lo(f, k), V_after(F(f, c), k));
+          boxes.hi(f, k) = std::max(boxes.hi(f, k), V_after(F(f, c), k));
+        }
+      }
+    }
     std::vector<int> all(F.rows());
     for (int f = 0; f < F.rows(); ++f) all[f] = f;
     pairs = OverlappingBoxes(boxes, all);
