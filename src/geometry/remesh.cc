@@ -827,14 +827,7 @@ struct PairCandidates {
   PairCandidates(const Eigen::MatrixXd& V_before, const Eigen::MatrixXd& V_after,
                  const Eigen::MatrixXi& F) {
     Boxes boxes = FaceBoxes(V_before, F);
-    for (Eigen::Index f = 0; f < F.rows(); ++f) {
-      for (int c = 0; c < 3; ++c) {
-        for (int k = 0; k < 3; ++k) {
-          boxes.lo(f, k) = std::min(boxes.lo(f, k), V_after(F(f, c), k));
-          boxes.hi(f, k) = std::max(boxes.hi(f, k), V_after(F(f, c), k));
-        }
-      }
-    }
+    GrowFaceBoxes(V_after, F, &boxes);
     std::vector<int> all(F.rows());
     for (int f = 0; f < F.rows(); ++f) all[f] = f;
     pairs = OverlappingBoxes(boxes, all);
@@ -862,22 +855,17 @@ UndoSelfIntersectionsSummary UndoOnMesh(const Eigen::MatrixXd& V_before, const E
   const PairCandidates candidates(V_before, *V_after, F);
   const int num_faces = static_cast<int>(F.rows());
   Boxes boxes = FaceBoxes(*V_after, F);
-  std::vector<char> degenerate(num_faces, 0);
-#pragma omp parallel for schedule(static)
-  for (int f = 0; f < num_faces; ++f) degenerate[f] = FaceIsDegenerate(*V_after, F, f) ? 1 : 0;
+  std::vector<char> degenerate = DegenerateFaces(*V_after, F);
 
   std::vector<char> reset(V_after->rows(), 0);
   // After the first (whole-mesh) check, new pairs can only involve faces
   // with a vertex reset in the last round: their candidates are checked.
   std::vector<int> changed_faces;
   std::vector<std::vector<int>> vertex_faces;
-  std::vector<int> to_check;  // candidate indices
-  std::vector<char> hit;
+  std::vector<int> to_check;  // indices of the candidates of the changed faces
   for (bool first = true;; first = false) {
     std::vector<std::pair<int, int>> pairs;
     if (first) {
-      to_check.resize(candidates.pairs.size());
-      for (size_t i = 0; i < to_check.size(); ++i) to_check[i] = static_cast<int>(i);
       for (int f = 0; f < num_faces; ++f) {
         if (degenerate[f]) pairs.emplace_back(f, f);
       }
@@ -891,17 +879,9 @@ UndoSelfIntersectionsSummary UndoOnMesh(const Eigen::MatrixXd& V_before, const E
       std::sort(to_check.begin(), to_check.end());
       to_check.erase(std::unique(to_check.begin(), to_check.end()), to_check.end());
     }
-    hit.assign(to_check.size(), 0);
-    const long num_checks = static_cast<long>(to_check.size());
-#pragma omp parallel for schedule(dynamic, 1024)
-    for (long i = 0; i < num_checks; ++i) {
-      const auto [a, b] = candidates.pairs[to_check[i]];
-      hit[i] = !degenerate[a] && !degenerate[b] && BoxesOverlap(boxes, a, boxes, b) &&
-               FacesIntersect(*V_after, F, a, b);
-    }
-    for (long i = 0; i < num_checks; ++i) {
-      if (hit[i]) pairs.push_back(candidates.pairs[to_check[i]]);
-    }
+    const std::vector<std::pair<int, int>> found = IntersectingCandidates(
+        *V_after, F, boxes, degenerate, candidates.pairs, first ? nullptr : &to_check);
+    pairs.insert(pairs.end(), found.begin(), found.end());
     std::sort(pairs.begin(), pairs.end());
     std::vector<int> offending;  // faces of new pairs, then flipped faces
     long new_pairs = 0;
@@ -939,12 +919,7 @@ UndoSelfIntersectionsSummary UndoOnMesh(const Eigen::MatrixXd& V_before, const E
     changed_faces.erase(std::unique(changed_faces.begin(), changed_faces.end()),
                         changed_faces.end());
     for (const int f : changed_faces) {
-      for (int k = 0; k < 3; ++k) {
-        const double x = (*V_after)(F(f, 0), k), y = (*V_after)(F(f, 1), k),
-                     z = (*V_after)(F(f, 2), k);
-        boxes.lo(f, k) = std::min({x, y, z});
-        boxes.hi(f, k) = std::max({x, y, z});
-      }
+      SetFaceBox(*V_after, F, f, &boxes);
       degenerate[f] = FaceIsDegenerate(*V_after, F, f) ? 1 : 0;
     }
     summary.reset_vertices += newly_reset;

@@ -80,8 +80,7 @@ void SortByCell(uint64_t num_cells, std::vector<std::pair<uint64_t, int>>* entri
 
 // The candidates by CGAL's box_intersection_d (sorting).
 std::vector<std::pair<int, int>> OverlappingBySorting(const Boxes& boxes,
-                                                      const std::vector<int>& ids,
-                                                      const std::vector<char>* only) {
+                                                      const std::vector<int>& ids) {
   using CgalBox = CGAL::Box_intersection_d::Box_with_info_d<double, 3, int>;
   std::vector<CgalBox> cgal_boxes;
   cgal_boxes.reserve(ids.size());
@@ -94,7 +93,6 @@ std::vector<std::pair<int, int>> OverlappingBySorting(const Boxes& boxes,
   CGAL::box_self_intersection_d(cgal_boxes.begin(), cgal_boxes.end(),
                                 [&](const CgalBox& x, const CgalBox& y) {
                                   const int a = x.info(), b = y.info();
-                                  if (only != nullptr && !(*only)[a] && !(*only)[b]) return;
                                   pairs.emplace_back(std::min(a, b), std::max(a, b));
                                 });
   return pairs;
@@ -103,7 +101,7 @@ std::vector<std::pair<int, int>> OverlappingBySorting(const Boxes& boxes,
 // The same by the uniform grid; false (and nothing) when the boxes crowd the
 // cells (more pairs to look at in the cells than kMaxPerBox a box).
 bool OverlappingByGrid(const Boxes& boxes, const std::vector<int>& ids,
-                       const std::vector<char>* only, std::vector<std::pair<int, int>>* out) {
+                       std::vector<std::pair<int, int>>* out) {
   constexpr double kMaxCellsPerBox = 8;
   constexpr double kMaxPerBox = 64;
   double origin[3], extent[3], size_sum = 0;
@@ -182,7 +180,6 @@ bool OverlappingByGrid(const Boxes& boxes, const std::vector<int>& ids,
       const int a = entries[i].second;
       for (size_t j = i + 1; j < starts[c + 1]; ++j) {
         const int b = entries[j].second;
-        if (only != nullptr && !(*only)[a] && !(*only)[b]) continue;
         if (!BoxesOverlap(boxes, a, boxes, b)) continue;
         const uint64_t corner = key(index(std::max(boxes.lo(a, 0), boxes.lo(b, 0)), 0),
                                     index(std::max(boxes.lo(a, 1), boxes.lo(b, 1)), 1),
@@ -210,18 +207,39 @@ bool FacesIntersect(const Eigen::MatrixXd& V, const Eigen::MatrixXi& F, int a, i
   return FacesIntersectAt(p, va, vb);
 }
 
+std::vector<char> DegenerateFaces(const Eigen::MatrixXd& V, const Eigen::MatrixXi& F) {
+  const int num_faces = static_cast<int>(F.rows());
+  std::vector<char> degenerate(num_faces, 0);
+#pragma omp parallel for schedule(static)
+  for (int f = 0; f < num_faces; ++f) degenerate[f] = FaceIsDegenerate(V, F, f) ? 1 : 0;
+  return degenerate;
+}
+
+void SetFaceBox(const Eigen::MatrixXd& V, const Eigen::MatrixXi& F, int f, Boxes* boxes) {
+  for (int k = 0; k < 3; ++k) {
+    const double x = V(F(f, 0), k), y = V(F(f, 1), k), z = V(F(f, 2), k);
+    boxes->lo(f, k) = std::min({x, y, z});
+    boxes->hi(f, k) = std::max({x, y, z});
+  }
+}
+
 Boxes FaceBoxes(const Eigen::MatrixXd& V, const Eigen::MatrixXi& F) {
   Boxes boxes;
   boxes.lo.resize(F.rows(), 3);
   boxes.hi.resize(F.rows(), 3);
+  for (int f = 0; f < F.rows(); ++f) SetFaceBox(V, F, f, &boxes);
+  return boxes;
+}
+
+void GrowFaceBoxes(const Eigen::MatrixXd& V, const Eigen::MatrixXi& F, Boxes* boxes) {
   for (Eigen::Index f = 0; f < F.rows(); ++f) {
-    for (int k = 0; k < 3; ++k) {
-      const double x = V(F(f, 0), k), y = V(F(f, 1), k), z = V(F(f, 2), k);
-      boxes.lo(f, k) = std::min({x, y, z});
-      boxes.hi(f, k) = std::max({x, y, z});
+    for (int c = 0; c < 3; ++c) {
+      for (int k = 0; k < 3; ++k) {
+        boxes->lo(f, k) = std::min(boxes->lo(f, k), V(F(f, c), k));
+        boxes->hi(f, k) = std::max(boxes->hi(f, k), V(F(f, c), k));
+      }
     }
   }
-  return boxes;
 }
 
 bool BoxesOverlap(const Boxes& x, int a, const Boxes& y, int b) {
@@ -231,41 +249,53 @@ bool BoxesOverlap(const Boxes& x, int a, const Boxes& y, int b) {
   return true;
 }
 
-std::vector<std::pair<int, int>> OverlappingBoxes(const Boxes& boxes, const std::vector<int>& ids,
-                                                  const std::vector<char>* only) {
-  MR_CHECK(only == nullptr || only->size() == static_cast<size_t>(boxes.lo.rows()));
+std::vector<std::pair<int, int>> OverlappingBoxes(const Boxes& boxes,
+                                                  const std::vector<int>& ids) {
   std::vector<std::pair<int, int>> pairs;
   if (ids.size() < 2) return pairs;
-  if (!OverlappingByGrid(boxes, ids, only, &pairs)) pairs = OverlappingBySorting(boxes, ids, only);
+  if (!OverlappingByGrid(boxes, ids, &pairs)) pairs = OverlappingBySorting(boxes, ids);
+  return pairs;
+}
+
+std::vector<std::pair<int, int>> IntersectingCandidates(
+    const Eigen::MatrixXd& V, const Eigen::MatrixXi& F, const Boxes& boxes,
+    const std::vector<char>& degenerate, const std::vector<std::pair<int, int>>& candidates,
+    const std::vector<int>* which) {
+  const long n = static_cast<long>(which != nullptr ? which->size() : candidates.size());
+  auto candidate = [&](long i) -> const std::pair<int, int>& {
+    return candidates[which != nullptr ? (*which)[i] : i];
+  };
+  std::vector<char> hit(n, 0);
+#pragma omp parallel for schedule(dynamic, 1024)
+  for (long i = 0; i < n; ++i) {
+    const auto [a, b] = candidate(i);
+    hit[i] = !degenerate[a] && !degenerate[b] && BoxesOverlap(boxes, a, boxes, b) &&
+             FacesIntersect(V, F, a, b);
+  }
+  std::vector<std::pair<int, int>> pairs;
+  for (long i = 0; i < n; ++i) {
+    if (hit[i]) pairs.push_back(candidate(i));
+  }
   return pairs;
 }
 
 std::vector<std::pair<int, int>> IntersectingFacePairs(const Eigen::MatrixXd& V,
-                                                       const Eigen::MatrixXi& F,
-                                                       const std::vector<char>* only) {
-  const int num_faces = static_cast<int>(F.rows());
-  MR_CHECK(only == nullptr || static_cast<int>(only->size()) == num_faces);
+                                                       const Eigen::MatrixXi& F) {
+  const std::vector<char> degenerate = DegenerateFaces(V, F);
   std::vector<std::pair<int, int>> pairs;
   std::vector<int> boxed;  // the non-degenerate faces
-  boxed.reserve(num_faces);
-  for (int f = 0; f < num_faces; ++f) {
-    if (!FaceIsDegenerate(V, F, f)) {
-      boxed.push_back(f);
-    } else if (only == nullptr || (*only)[f]) {
+  boxed.reserve(F.rows());
+  for (int f = 0; f < F.rows(); ++f) {
+    if (degenerate[f]) {
       pairs.emplace_back(f, f);
+    } else {
+      boxed.push_back(f);
     }
   }
-  const std::vector<std::pair<int, int>> candidates =
-      OverlappingBoxes(FaceBoxes(V, F), boxed, only);
-  std::vector<char> hit(candidates.size(), 0);
-  const long num_candidates = static_cast<long>(candidates.size());
-#pragma omp parallel for schedule(dynamic, 1024)
-  for (long i = 0; i < num_candidates; ++i) {
-    hit[i] = FacesIntersect(V, F, candidates[i].first, candidates[i].second) ? 1 : 0;
-  }
-  for (long i = 0; i < num_candidates; ++i) {
-    if (hit[i]) pairs.push_back(candidates[i]);
-  }
+  const Boxes boxes = FaceBoxes(V, F);
+  const std::vector<std::pair<int, int>> found =
+      IntersectingCandidates(V, F, boxes, degenerate, OverlappingBoxes(boxes, boxed));
+  pairs.insert(pairs.end(), found.begin(), found.end());
   std::sort(pairs.begin(), pairs.end());
   return pairs;
 }

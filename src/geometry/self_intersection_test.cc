@@ -110,22 +110,6 @@ TEST(IntersectingFacePairs, FoldedEdgeAndDegenerateFaceAsCgal) {
   EXPECT_TRUE(std::binary_search(pairs.begin(), pairs.end(), std::make_pair(f, f)));
 }
 
-TEST(IntersectingFacePairs, OnlyKeepsThePairsOfFlaggedFaces) {
-  Eigen::MatrixXd V;
-  Eigen::MatrixXi F;
-  NoisySphere(4, 0.05, 7, &V, &F);
-  const auto all = IntersectingFacePairs(V, F);
-  ASSERT_GT(all.size(), 20u);
-  std::vector<char> only(F.rows(), 0);
-  for (int f = 0; f < F.rows(); f += 5) only[f] = 1;
-  std::vector<std::pair<int, int>> expected;
-  for (const auto& p : all) {
-    if (only[p.first] || only[p.second]) expected.push_back(p);
-  }
-  ASSERT_FALSE(expected.empty());
-  EXPECT_EQ(IntersectingFacePairs(V, F, &only), expected);
-}
-
 // Faces of very different sizes crowd the cells of the grid: the candidates
 // then come from box_intersection_d, with the same answer.
 TEST(IntersectingFacePairs, CrowdedCellsAsCgal) {
