@@ -290,6 +290,70 @@ struct FocalPrior {
   double fx0, fy0, inv_sx, inv_sy;
 };
 
+// The datum of a camera set: its mean centre shift, mean rotation change
+// (world frame) and scale change from the reference cameras (R0_k, C0_k), to
+// first order the translation, rotation and scale of the similarity that
+// carries the reference set onto the current one. Parameter blocks R_0, C_0,
+// R_1, C_1, ... (row-major 9, 3); residuals (7):
+//   (1/N) Σ (C_k - C0_k) / sigma_center
+//   (1/N) Σ vee(skew(R0_kᵀ R_k)) / sigma_rotation
+//   Σ (C_k - C0_k)·(C0_k - c̄0) / Σ |C0_k - c̄0|² / sigma_scale
+// The three are independent to first order: a common shift leaves the
+// rotation and scale terms at 0, a rotation of the set about c̄0 the shift
+// and scale terms, and a scaling about c̄0 the shift and rotation terms.
+struct CameraSetDatum {
+  CameraSetDatum(std::vector<Eigen::Matrix3d> R0, std::vector<Eigen::Vector3d> C0,
+                 double sigma_center, double sigma_rotation, double sigma_scale)
+      : R0(std::move(R0)),
+        C0(std::move(C0)),
+        inv_center(1.0 / sigma_center),
+        inv_rotation(1.0 / sigma_rotation),
+        inv_scale(1.0 / sigma_scale) {
+    Eigen::Vector3d mean = Eigen::Vector3d::Zero();
+    for (const Eigen::Vector3d& c : this->C0) mean += c;
+    mean /= static_cast<double>(this->C0.size());
+    double spread = 0;
+    for (const Eigen::Vector3d& c : this->C0) {
+      radial.push_back(c - mean);
+      spread += (c - mean).squaredNorm();
+    }
+    for (Eigen::Vector3d& r : radial) r = spread > 0 ? Eigen::Vector3d(r / spread) : Eigen::Vector3d::Zero();
+  }
+  template <typename T>
+  bool operator()(T const* const* blocks, T* residual) const {
+    const int n = static_cast<int>(C0.size());
+    for (int e = 0; e < 7; ++e) residual[e] = T(0);
+    for (int k = 0; k < n; ++k) {
+      const T* R = blocks[2 * k];
+      const T* C = blocks[2 * k + 1];
+      T M[3][3];  // R0ᵀ R
+      for (int a = 0; a < 3; ++a) {
+        for (int b = 0; b < 3; ++b) {
+          M[a][b] = R0[k](0, a) * R[b] + R0[k](1, a) * R[3 + b] + R0[k](2, a) * R[6 + b];
+        }
+      }
+      residual[3] += 0.5 * (M[2][1] - M[1][2]);
+      residual[4] += 0.5 * (M[0][2] - M[2][0]);
+      residual[5] += 0.5 * (M[1][0] - M[0][1]);
+      for (int e = 0; e < 3; ++e) {
+        const T shift = C[e] - C0[k](e);
+        residual[e] += shift;
+        residual[6] += shift * radial[k](e);
+      }
+    }
+    for (int e = 0; e < 3; ++e) {
+      residual[e] *= inv_center / n;
+      residual[3 + e] *= inv_rotation / n;
+    }
+    residual[6] *= inv_scale;
+    return true;
+  }
+  std::vector<Eigen::Matrix3d> R0;
+  std::vector<Eigen::Vector3d> C0;
+  std::vector<Eigen::Vector3d> radial;  // (C0_k - c̄0) / Σ |C0_k - c̄0|²
+  double inv_center, inv_rotation, inv_scale;
+};
+
 }  // namespace
 
 ceres::CostFunction* NewPhotometricCost(const PhotometricSample& sample, const cv::Mat& image_j,
@@ -299,6 +363,21 @@ ceres::CostFunction* NewPhotometricCost(const PhotometricSample& sample, const c
 }
 
 ceres::Manifold* NewRotationMatrixManifold() { return new RotationMatrixManifold(); }
+
+ceres::CostFunction* NewCameraSetDatumCost(const std::vector<Eigen::Matrix3d>& R0,
+                                           const std::vector<Eigen::Vector3d>& C0,
+                                           double sigma_center, double sigma_rotation,
+                                           double sigma_scale) {
+  MR_CHECK(R0.size() == C0.size() && C0.size() >= 2);
+  auto* cost = new ceres::DynamicAutoDiffCostFunction<CameraSetDatum, 4>(
+      new CameraSetDatum(R0, C0, sigma_center, sigma_rotation, sigma_scale));
+  for (size_t k = 0; k < C0.size(); ++k) {
+    cost->AddParameterBlock(9);
+    cost->AddParameterBlock(3);
+  }
+  cost->SetNumResiduals(7);
+  return cost;
+}
 
 std::vector<PhotometricSample> SelectSamples(const Eigen::MatrixXd& V, const Eigen::MatrixXi& F,
                                              const Eigen::MatrixXd& face_normals,
@@ -426,6 +505,10 @@ bool CameraRefinementOptions::Check() const {
   if (!(surface_sigma_px >= 0 && std::isfinite(surface_sigma_px))) {
     MR_THROW_INPUT << "CameraRefinementOptions::surface_sigma_px = " << surface_sigma_px
                    << ". Violated constraint: 0 <= surface_sigma_px < inf";
+  }
+  if (!(datum_sigma_px >= 0 && std::isfinite(datum_sigma_px))) {
+    MR_THROW_INPUT << "CameraRefinementOptions::datum_sigma_px = " << datum_sigma_px
+                   << ". Violated constraint: 0 <= datum_sigma_px < inf";
   }
   if (!(function_tolerance > 0 && function_tolerance < 1)) {
     MR_THROW_INPUT << "CameraRefinementOptions::function_tolerance = " << function_tolerance
@@ -679,6 +762,43 @@ void BuildProblem(const std::vector<cv::Mat>& gray_images, const std::vector<Ord
     ordering->AddElementToGroup(p.rotation[i].data(), 1);
     ordering->AddElementToGroup(p.center[i].data(), 1);
   }
+  // The datum of the refined set, held at the prior views' when the surface
+  // is free (a fixed mesh, or fixed views, hold it themselves).
+  std::vector<int> datum_views;
+  for (size_t i = 0; i < refined->size(); ++i) {
+    if ((*refined)[i]) datum_views.push_back(static_cast<int>(i));
+  }
+  const bool any_fixed = std::find(fixed.begin(), fixed.end(), 1) != fixed.end();
+  if (free_surface && options.datum_sigma_px > 0 && !any_fixed && datum_views.size() >= 2) {
+    std::vector<Eigen::Matrix3d> R0;
+    std::vector<Eigen::Vector3d> C0;
+    std::vector<double*> blocks;
+    double mean_footprint = 0, mean_focal = 0;
+    for (int i : datum_views) {
+      R0.push_back(Eigen::Map<const internal::RowMatrix3d>(prior.rotation[i].data()));
+      C0.push_back(Eigen::Map<const Eigen::Vector3d>(prior.center[i].data()));
+      blocks.push_back(p.rotation[i].data());
+      blocks.push_back(p.center[i].data());
+      mean_footprint += footprint[i];
+      const std::array<double, 4>& k = prior.intrinsics[prior.block_of_view[i]];
+      mean_focal += 0.5 * (k[0] + k[1]);
+    }
+    mean_footprint /= datum_views.size();
+    mean_focal /= datum_views.size();
+    Eigen::Vector3d mean_center = Eigen::Vector3d::Zero();
+    for (const Eigen::Vector3d& c : C0) mean_center += c;
+    mean_center /= static_cast<double>(C0.size());
+    double spread = 0;
+    for (const Eigen::Vector3d& c : C0) spread += (c - mean_center).squaredNorm();
+    const double radius = std::sqrt(spread / C0.size());
+    if (radius > 0) {
+      const double sigma = options.datum_sigma_px;
+      problem->AddResidualBlock(
+          internal::NewCameraSetDatumCost(R0, C0, sigma * mean_footprint, sigma / mean_focal,
+                                          sigma * mean_footprint / radius),
+          nullptr, blocks);
+    }
+  }
   std::vector<char> fixed_block(p.intrinsics.size(), 0);
   for (size_t i = 0; i < fixed.size(); ++i) {
     if (fixed[i]) fixed_block[p.block_of_view[i]] = 1;
@@ -822,6 +942,30 @@ CameraRefinementSummary RefineCameras(const std::vector<cv::Mat>& gray_images,
     return summary;
   }
   WriteBack(params, refined, intrinsics, views, &summary);
+  {
+    std::vector<Eigen::Matrix3d> R0;
+    std::vector<Eigen::Vector3d> C0;
+    std::vector<const double*> blocks;
+    double mean_footprint = 0;
+    for (int i = 0; i < num_views; ++i) {
+      if (!refined[i]) continue;
+      R0.push_back(Eigen::Map<const internal::RowMatrix3d>(prior.rotation[i].data()));
+      C0.push_back(Eigen::Map<const Eigen::Vector3d>(prior.center[i].data()));
+      blocks.push_back(params.rotation[i].data());
+      blocks.push_back(params.center[i].data());
+      mean_footprint += summary.footprint[i];
+    }
+    if (C0.size() >= 2) {
+      mean_footprint /= C0.size();
+      std::unique_ptr<ceres::CostFunction> datum(
+          internal::NewCameraSetDatumCost(R0, C0, mean_footprint, kDegree, 1.0));
+      double r[7];
+      datum->Evaluate(blocks.data(), r, nullptr);
+      summary.set_shift_px = Eigen::Vector3d(r[0], r[1], r[2]).norm();
+      summary.set_rotation_deg = Eigen::Vector3d(r[3], r[4], r[5]).norm();
+      summary.set_scale_change = r[6];
+    }
+  }
   std::vector<double> offsets_px;
   for (size_t f = 0; f < params.surface_sigma.size(); ++f) {
     if (params.surface_sigma[f] == 0) continue;
@@ -866,6 +1010,10 @@ std::string CameraRefinementSummary::BriefReport() const {
       << " iterations" << (converged ? "" : " (not converged)") << "; largest change: rotation "
       << std::setprecision(3) << MaxOf(rotation_change_deg) << " deg, centre "
       << MaxOf(center_change_px) << " px footprints";
+  if (num_views_refined >= 2) {
+    out << "; the set moved " << set_shift_px << " px footprints, turned " << set_rotation_deg
+        << " deg, scaled " << set_scale_change;
+  }
   if (!focal_change_percent.empty()) {
     double focal = 0;
     for (const auto& [camera, percent] : focal_change_percent) {

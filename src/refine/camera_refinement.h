@@ -89,6 +89,17 @@ struct CameraRefinementOptions {
   // (accuracy90 1.006x / 2.097x the exact-camera run against 1.012x /
   // 2.102x) in 4-17 iterations instead of 23-31, 2-3x faster.
   double function_tolerance = 1e-3;
+  // 1-sigma of the camera set's datum, in pixels: the mean centre shift of
+  // the refined views (in mean pixel footprints), their mean rotation (in
+  // pixels at the mean focal length) and the scale of the set (in mean
+  // footprints at the set's RMS radius), all from the prior views (>= 0).
+  // The images and the free face planes barely see a rotation of the whole
+  // set about the object, which the per-view priors alone hold only to
+  // prior_rotation_deg / sqrt(#views), and in mesh_refiner the surface
+  // follows the cameras wherever they go. 0 leaves the datum to the
+  // per-view priors. Applied only with free face planes (surface_sigma_px >
+  // 0) and no fixed views: a fixed mesh, or fixed views, hold the frame.
+  double datum_sigma_px = 0.01;
 
   bool Check() const;
 };
@@ -117,6 +128,12 @@ struct CameraRefinementSummary {
   // (fx + fy) / 2 in percent, and of the principal point in pixels.
   std::map<int, double> focal_change_percent;
   std::map<int, double> principal_point_change_px;
+  // How the refined set as a whole moved from the prior views (the datum
+  // that datum_sigma_px holds): mean centre shift (in mean pixel footprints),
+  // angle of the mean world-frame rotation (degrees), relative scale change.
+  double set_shift_px = 0;
+  double set_rotation_deg = 0;
+  double set_scale_change = 0;
   int iterations = 0;
   bool converged = false;
   std::string ceres_brief_report;
@@ -205,6 +222,18 @@ ceres::CostFunction* NewPhotometricCost(const PhotometricSample& sample, const c
 // The rotation matrices (row-major, 9 values) with the tangent update
 // Plus(R, δ) = Exp(δ) R (δ an angle-axis vector in the camera frame).
 ceres::Manifold* NewRotationMatrixManifold();
+
+// The datum of a camera set against reference cameras (R0_k cam_from_world,
+// C0_k centres; at least 2) as a ceres::CostFunction of the blocks R_0 (9,
+// row-major), C_0 (3), R_1, C_1, ...: 7 residuals, the mean centre shift / sigma_center
+// (scene units), the mean world-frame rotation change vee(skew(R0_kᵀ R_k)) /
+// sigma_rotation (radians) and the relative scale change of the set about
+// its mean centre / sigma_scale, each 0 at the reference and independent of
+// the others to first order (see camera_refinement.cc).
+ceres::CostFunction* NewCameraSetDatumCost(const std::vector<Eigen::Matrix3d>& R0,
+                                           const std::vector<Eigen::Vector3d>& C0,
+                                           double sigma_center, double sigma_rotation,
+                                           double sigma_scale);
 
 }  // namespace internal
 }  // namespace mr

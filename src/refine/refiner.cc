@@ -1157,6 +1157,9 @@ void RegisterRefineOptions(OptionManager* o, RefineOptions* r) {
          "Ceres iterations (>= 1)");
   o->Add("CameraRefinement.function_tolerance", &r->camera_refinement.function_tolerance,
          "Ceres stops when an iteration lowers the cost by less than this fraction");
+  o->Add("CameraRefinement.datum_sigma_px", &r->camera_refinement.datum_sigma_px,
+         "1-sigma of the camera set's mean shift, rotation and scale from the input cameras "
+         "(pixels); 0 leaves them to the per-view priors");
   o->Add("Refine.noise_from_step", &r->noise_from_step,
          "lp proximal step: noise estimated from what the gradient step added, not the surface");
   o->Add("Refine.silhouette_weight", &r->silhouette_weight,
