@@ -139,6 +139,7 @@ struct CameraRefinementSummary {
   std::string ceres_brief_report;
   std::string ceres_full_report;
   double seconds = 0;
+  double sample_seconds = 0;  // of which rendering the views and picking the samples
 
   // One line: mode, counts, cost before and after, largest changes, time.
   std::string BriefReport() const;

@@ -143,16 +143,17 @@ struct RefineOptions {
   // relief off), "laplacian" (1st+2nd order, the isotropic baseline), or
   // "none".
   std::string regularizer = "bilateral_normal";
-  // Photometric refinement of the cameras against the current mesh at the
-  // start of every level but the first, after its remeshing, and halfway
-  // through the finest level (camera_refinement.h), with priors centred on
+  // Photometric refinement of the cameras against the current mesh halfway
+  // through the finest level (camera_rounds times, evenly spaced;
+  // camera_refinement.h), with priors centred on
   // the input cameras: "none", "poses" (rotation and centre of every view)
   // or "poses_intrinsics" (also fx, fy, cx, cy, shared by the views of one
   // camera). The level's images of all views are held at once for it; a
   // level whose images would take more than half of cache_mb is not refined
   // (logged). Default "none": on the corpus it helps where the cameras are
-  // 0.5-2 px off, but on COLMAP's own cameras of templeSparseRing it lowers
-  // the held-out photo-consistency (docs/camera_refinement.md).
+  // 0.5-2 px off, but with exact cameras it costs 1-3 % of accuracy90 and
+  // on COLMAP's own cameras of templeSparseRing it lowers the held-out
+  // photo-consistency a little (0.625 -> 0.612; docs/camera_refinement.md).
   std::string refine_cameras = "none";
   // How often refine_cameras refines them within the finest level, at evenly
   // spaced iterations (>= 1; 1: halfway). Measured after the datum alignment

@@ -526,6 +526,19 @@ TEST_F(RefinerTest, CameraRefinementUndoesPoseError) {
   std::printf("two camera rounds: pose error %.3f -> %.3f px, accuracy90 %.4f\n", error_before,
               error_two, Evaluate(twice.V, twice.F, V, F).accuracy90);
   EXPECT_LT(error_two, error_after) << two.camera_reports[1];  // 0.342 -> 0.292 px
+
+  // Two levels: still only within the finest one, never at the coarse
+  // level's surface.
+  options.camera_rounds = 1;
+  options.num_levels = 2;
+  TriangleMesh levels;
+  levels.V = V;
+  levels.F = F;
+  const RefineSummary coarse = RefineMesh(wrong, options, &levels, renderer_);
+  ASSERT_FALSE(coarse.iterations.empty());
+  EXPECT_EQ(coarse.iterations.front().level, 1) << coarse.FullReport();
+  ASSERT_EQ(coarse.camera_reports.size(), 1u) << coarse.FullReport();
+  EXPECT_EQ(coarse.camera_reports[0].rfind("level 0: ", 0), 0u) << coarse.camera_reports[0];
 }
 
 TEST(ResizedViewSource, ImagesAndCamerasScaleTogether) {
