@@ -12,6 +12,7 @@
 
 #include <Eigen/Geometry>
 #include <ceres/ceres.h>
+#include <ceres/product_manifold.h>
 #include <opencv2/imgproc.hpp>
 
 #include "geometry/mesh.h"
@@ -127,9 +128,9 @@ bool EvaluatePhotometric(const PhotometricSample& s, const cv::Mat& image_j, con
   return true;
 }
 
-// Parameters: R_i, C_i, K_i, R_j, C_j, K_j, (a, b) and, with a free surface,
-// δ; views i and j of one camera (shared intrinsics): R_i, C_i, R_j, C_j, K,
-// (a, b)[, δ].
+// Parameters: pose_i (R_i, C_i: 12), K_i, pose_j, K_j, (a, b) and, with a
+// free surface, δ; views i and j of one camera (shared intrinsics): pose_i,
+// pose_j, K, (a, b)[, δ].
 class PhotometricCost : public ceres::CostFunction {
  public:
   PhotometricCost(const PhotometricSample& sample, const cv::Mat& image_j, bool shared_intrinsics,
@@ -137,27 +138,30 @@ class PhotometricCost : public ceres::CostFunction {
       : sample_(sample), image_j_(image_j), shared_(shared_intrinsics), free_(free_surface) {
     set_num_residuals(1);
     std::vector<int32_t>* sizes = mutable_parameter_block_sizes();
-    *sizes = shared_ ? std::vector<int32_t>{9, 3, 9, 3, 4, 2}
-                     : std::vector<int32_t>{9, 3, 4, 9, 3, 4, 2};
+    *sizes = shared_ ? std::vector<int32_t>{12, 12, 4, 2} : std::vector<int32_t>{12, 4, 12, 4, 2};
     if (free_) sizes->push_back(1);
   }
   bool Evaluate(double const* const* p, double* residual, double** J) const override {
-    const auto jac = [J](int k) { return J == nullptr ? nullptr : J[k]; };
+    // A pose block is (R row-major, C); its Jacobian row likewise.
+    const auto jac = [J](int k, int offset) {
+      return J == nullptr || J[k] == nullptr ? nullptr : J[k] + offset;
+    };
     if (!shared_) {
-      return EvaluatePhotometric(sample_, image_j_, p[0], p[1], p[2], p[3], p[4], p[5], p[6],
-                                 free_ ? p[7] : nullptr, residual, jac(0), jac(1), jac(2), jac(3),
-                                 jac(4), jac(5), jac(6), free_ ? jac(7) : nullptr);
+      return EvaluatePhotometric(sample_, image_j_, p[0], p[0] + 9, p[1], p[2], p[2] + 9, p[3],
+                                 p[4], free_ ? p[5] : nullptr, residual, jac(0, 0), jac(0, 9),
+                                 jac(1, 0), jac(2, 0), jac(2, 9), jac(3, 0), jac(4, 0),
+                                 free_ ? jac(5, 0) : nullptr);
     }
     double J_Ki[4], J_Kj[4];
-    const bool want_k = jac(4) != nullptr;
-    if (!EvaluatePhotometric(sample_, image_j_, p[0], p[1], p[4], p[2], p[3], p[4], p[5],
-                             free_ ? p[6] : nullptr, residual, jac(0), jac(1),
-                             want_k ? J_Ki : nullptr, jac(2), jac(3), want_k ? J_Kj : nullptr,
-                             jac(5), free_ ? jac(6) : nullptr)) {
+    const bool want_k = jac(2, 0) != nullptr;
+    if (!EvaluatePhotometric(sample_, image_j_, p[0], p[0] + 9, p[2], p[1], p[1] + 9, p[2], p[3],
+                             free_ ? p[4] : nullptr, residual, jac(0, 0), jac(0, 9),
+                             want_k ? J_Ki : nullptr, jac(1, 0), jac(1, 9),
+                             want_k ? J_Kj : nullptr, jac(3, 0), free_ ? jac(4, 0) : nullptr)) {
       return false;
     }
     if (want_k) {
-      for (int k = 0; k < 4; ++k) J[4][k] = J_Ki[k] + J_Kj[k];
+      for (int k = 0; k < 4; ++k) J[2][k] = J_Ki[k] + J_Kj[k];
     }
     return true;
   }
@@ -232,8 +236,8 @@ class RotationMatrixManifold : public ceres::Manifold {
   }
 };
 
-// Prior on a rotation (row-major 9 values): vee(skew(R R0ᵀ)) / sigma, which
-// is sin(angle) * axis / sigma.
+// Prior on the rotation of a pose block (R row-major, C): vee(skew(R R0ᵀ)) /
+// sigma, which is sin(angle) * axis / sigma.
 struct RotationPrior {
   RotationPrior(const Eigen::Matrix3d& R0, double sigma) : R0(R0), inv_sigma(1.0 / sigma) {}
   template <typename T>
@@ -253,10 +257,12 @@ struct RotationPrior {
   double inv_sigma;
 };
 
+// Prior on the centre of a pose block: (C - C0) / sigma.
 struct CenterPrior {
   CenterPrior(const Eigen::Vector3d& C0, double sigma) : C0(C0), inv_sigma(1.0 / sigma) {}
   template <typename T>
-  bool operator()(const T* C, T* residual) const {
+  bool operator()(const T* pose, T* residual) const {
+    const T* C = pose + 9;
     for (int k = 0; k < 3; ++k) residual[k] = (C[k] - C0(k)) * inv_sigma;
     return true;
   }
@@ -294,8 +300,8 @@ struct FocalPrior {
 // The datum of a camera set: its mean centre shift, mean rotation change
 // (world frame) and scale change from the reference cameras (R0_k, C0_k), to
 // first order the translation, rotation and scale of the similarity that
-// carries the reference set onto the current one. Parameter blocks R_0, C_0,
-// R_1, C_1, ... (row-major 9, 3); residuals (7):
+// carries the reference set onto the current one. Parameter blocks: the
+// poses (R row-major, C: 12 values) of the cameras; residuals (7):
 //   (1/N) Σ (C_k - C0_k) / sigma_center
 //   (1/N) Σ vee(skew(R0_kᵀ R_k)) / sigma_rotation
 //   Σ (C_k - C0_k)·(C0_k - c̄0) / Σ |C0_k - c̄0|² / sigma_scale
@@ -325,8 +331,8 @@ struct CameraSetDatum {
     const int n = static_cast<int>(C0.size());
     for (int e = 0; e < 7; ++e) residual[e] = T(0);
     for (int k = 0; k < n; ++k) {
-      const T* R = blocks[2 * k];
-      const T* C = blocks[2 * k + 1];
+      const T* R = blocks[k];
+      const T* C = blocks[k] + 9;
       T M[3][3];  // R0ᵀ R
       for (int a = 0; a < 3; ++a) {
         for (int b = 0; b < 3; ++b) {
@@ -365,6 +371,10 @@ ceres::CostFunction* NewPhotometricCost(const PhotometricSample& sample, const c
 
 ceres::Manifold* NewRotationMatrixManifold() { return new RotationMatrixManifold(); }
 
+ceres::Manifold* NewPoseManifold() {
+  return new ceres::ProductManifold<RotationMatrixManifold, ceres::EuclideanManifold<3>>();
+}
+
 ceres::CostFunction* NewCameraSetDatumCost(const std::vector<Eigen::Matrix3d>& R0,
                                            const std::vector<Eigen::Vector3d>& C0,
                                            double sigma_center, double sigma_rotation,
@@ -372,10 +382,7 @@ ceres::CostFunction* NewCameraSetDatumCost(const std::vector<Eigen::Matrix3d>& R
   MR_CHECK(R0.size() == C0.size() && C0.size() >= 2);
   auto* cost = new ceres::DynamicAutoDiffCostFunction<CameraSetDatum, 4>(
       new CameraSetDatum(R0, C0, sigma_center, sigma_rotation, sigma_scale));
-  for (size_t k = 0; k < C0.size(); ++k) {
-    cost->AddParameterBlock(9);
-    cost->AddParameterBlock(3);
-  }
+  for (size_t k = 0; k < C0.size(); ++k) cost->AddParameterBlock(12);
   cost->SetNumResiduals(7);
   return cost;
 }
@@ -590,8 +597,9 @@ void CheckInputs(const std::vector<cv::Mat>& gray_images,
 
 // The parameter blocks of the problem (their addresses must not move).
 struct CameraParameters {
-  std::vector<std::array<double, 9>> rotation;  // per view, row-major cam_from_world
-  std::vector<std::array<double, 3>> center;    // per view
+  // Per view: the row-major cam_from_world rotation and the centre, one
+  // block (the Schur complement then updates one cell per pair of views).
+  std::vector<std::array<double, 12>> pose;
   // Intrinsics (fx, fy, cx, cy): one block per camera (poses_intrinsics) or
   // per view (poses, held constant), and the camera id of each block.
   std::vector<std::array<double, 4>> intrinsics;
@@ -610,15 +618,14 @@ CameraParameters InitialParameters(const std::vector<PinholeView>& views,
                                    const std::vector<int>& camera_of_view, bool per_camera) {
   const int num_views = static_cast<int>(views.size());
   CameraParameters p;
-  p.rotation.resize(num_views);
-  p.center.resize(num_views);
+  p.pose.resize(num_views);
   p.block_of_view.resize(num_views);
   std::map<int, int> block_of_camera;
   std::vector<int> first_view_of_block;
   for (int i = 0; i < num_views; ++i) {
     const PinholeView& v = views[i];
-    Eigen::Map<internal::RowMatrix3d>(p.rotation[i].data()) = v.R;
-    Eigen::Map<Eigen::Vector3d>(p.center[i].data()) = v.Center();
+    Eigen::Map<internal::RowMatrix3d>(p.pose[i].data()) = v.R;
+    Eigen::Map<Eigen::Vector3d>(p.pose[i].data() + 9) = v.Center();
     const int camera = camera_of_view.empty() ? i : camera_of_view[i];
     const std::array<double, 4> k = {v.fx, v.fy, v.cx, v.cy};
     const auto [it, inserted] =
@@ -720,10 +727,10 @@ void BuildProblem(const std::vector<cv::Mat>& gray_images, const std::vector<Ord
     const int i = ordered[k].i, j = ordered[k].j;
     const int bi = p.block_of_view[i], bj = p.block_of_view[j];
     for (const auto& sample : ordered[k].samples) {
-      std::vector<double*> blocks = {p.rotation[i].data(), p.center[i].data()};
+      std::vector<double*> blocks = {p.pose[i].data()};
       if (bi != bj) blocks.push_back(p.intrinsics[bi].data());
-      blocks.insert(blocks.end(), {p.rotation[j].data(), p.center[j].data(),
-                                   p.intrinsics[bj].data(), p.brightness[k].data()});
+      blocks.insert(blocks.end(),
+                    {p.pose[j].data(), p.intrinsics[bj].data(), p.brightness[k].data()});
       if (free_surface) blocks.push_back(&p.surface_offset[sample.face]);
       problem->AddResidualBlock(
           internal::NewPhotometricCost(sample, gray_images[j], bi == bj, free_surface), loss,
@@ -743,29 +750,27 @@ void BuildProblem(const std::vector<cv::Mat>& gray_images, const std::vector<Ord
     ordering->AddElementToGroup(&p.surface_offset[f], 0);
   }
 
-  ceres::Manifold* manifold = internal::NewRotationMatrixManifold();
+  ceres::Manifold* manifold = internal::NewPoseManifold();
   for (size_t i = 0; i < refined->size(); ++i) {
-    if (fixed[i] && problem->HasParameterBlock(p.rotation[i].data())) {
-      problem->SetParameterBlockConstant(p.rotation[i].data());
-      problem->SetParameterBlockConstant(p.center[i].data());
-      ordering->AddElementToGroup(p.rotation[i].data(), 1);
-      ordering->AddElementToGroup(p.center[i].data(), 1);
+    double* pose = p.pose[i].data();
+    if (fixed[i] && problem->HasParameterBlock(pose)) {
+      problem->SetParameterBlockConstant(pose);
+      ordering->AddElementToGroup(pose, 1);
     }
     if (!(*refined)[i]) continue;
-    const Eigen::Matrix3d R0 = Eigen::Map<const internal::RowMatrix3d>(prior.rotation[i].data());
-    const Eigen::Vector3d C0 = Eigen::Map<const Eigen::Vector3d>(prior.center[i].data());
-    problem->SetManifold(p.rotation[i].data(), manifold);
+    const Eigen::Matrix3d R0 = Eigen::Map<const internal::RowMatrix3d>(prior.pose[i].data());
+    const Eigen::Vector3d C0 = Eigen::Map<const Eigen::Vector3d>(prior.pose[i].data() + 9);
+    problem->SetManifold(pose, manifold);
     problem->AddResidualBlock(
-        new ceres::AutoDiffCostFunction<internal::RotationPrior, 3, 9>(
+        new ceres::AutoDiffCostFunction<internal::RotationPrior, 3, 12>(
             new internal::RotationPrior(R0, options.prior_rotation_deg * kDegree)),
-        nullptr, p.rotation[i].data());
+        nullptr, pose);
     MR_CHECK_GT(footprint[i], 0);
     problem->AddResidualBlock(
-        new ceres::AutoDiffCostFunction<internal::CenterPrior, 3, 3>(
+        new ceres::AutoDiffCostFunction<internal::CenterPrior, 3, 12>(
             new internal::CenterPrior(C0, options.prior_center_px * footprint[i])),
-        nullptr, p.center[i].data());
-    ordering->AddElementToGroup(p.rotation[i].data(), 1);
-    ordering->AddElementToGroup(p.center[i].data(), 1);
+        nullptr, pose);
+    ordering->AddElementToGroup(pose, 1);
   }
   // The datum of the refined set, held at the prior views' when the surface
   // is free (a fixed mesh, or fixed views, hold it themselves).
@@ -780,10 +785,9 @@ void BuildProblem(const std::vector<cv::Mat>& gray_images, const std::vector<Ord
     std::vector<double*> blocks;
     double mean_footprint = 0, mean_focal = 0;
     for (int i : datum_views) {
-      R0.push_back(Eigen::Map<const internal::RowMatrix3d>(prior.rotation[i].data()));
-      C0.push_back(Eigen::Map<const Eigen::Vector3d>(prior.center[i].data()));
-      blocks.push_back(p.rotation[i].data());
-      blocks.push_back(p.center[i].data());
+      R0.push_back(Eigen::Map<const internal::RowMatrix3d>(prior.pose[i].data()));
+      C0.push_back(Eigen::Map<const Eigen::Vector3d>(prior.pose[i].data() + 9));
+      blocks.push_back(p.pose[i].data());
       mean_footprint += footprint[i];
       const std::array<double, 4>& k = prior.intrinsics[prior.block_of_view[i]];
       mean_focal += 0.5 * (k[0] + k[1]);
@@ -830,8 +834,8 @@ void WriteBack(const CameraParameters& p, const std::vector<char>& refined, bool
   for (size_t i = 0; i < views->size(); ++i) {
     PinholeView& view = (*views)[i];
     if (refined[i]) {
-      const Eigen::Matrix3d R = Eigen::Map<const internal::RowMatrix3d>(p.rotation[i].data());
-      const Eigen::Vector3d C = Eigen::Map<const Eigen::Vector3d>(p.center[i].data());
+      const Eigen::Matrix3d R = Eigen::Map<const internal::RowMatrix3d>(p.pose[i].data());
+      const Eigen::Vector3d C = Eigen::Map<const Eigen::Vector3d>(p.pose[i].data() + 9);
       summary->rotation_change_deg[i] =
           internal::LogRotation(R * view.R.transpose()).norm() / kDegree;
       summary->center_change[i] = (C - view.Center()).norm();
@@ -955,10 +959,9 @@ CameraRefinementSummary RefineCameras(const std::vector<cv::Mat>& gray_images,
     double mean_footprint = 0;
     for (int i = 0; i < num_views; ++i) {
       if (!refined[i]) continue;
-      R0.push_back(Eigen::Map<const internal::RowMatrix3d>(prior.rotation[i].data()));
-      C0.push_back(Eigen::Map<const Eigen::Vector3d>(prior.center[i].data()));
-      blocks.push_back(params.rotation[i].data());
-      blocks.push_back(params.center[i].data());
+      R0.push_back(Eigen::Map<const internal::RowMatrix3d>(prior.pose[i].data()));
+      C0.push_back(Eigen::Map<const Eigen::Vector3d>(prior.pose[i].data() + 9));
+      blocks.push_back(params.pose[i].data());
       mean_footprint += summary.footprint[i];
     }
     if (C0.size() >= 2) {

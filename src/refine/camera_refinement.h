@@ -209,11 +209,11 @@ std::vector<PhotometricSample> SelectSamples(const Eigen::MatrixXd& V, const Eig
                                              int max_samples);
 
 // The photometric residual r = I_j(q) - (a I_i(p) + b) of one sample as a
-// ceres::CostFunction with analytic Jacobians. Parameter blocks, with
-// rotations as row-major 3x3 cam_from_world matrices (9 values, with
-// RotationMatrixManifold) and intrinsics as (fx, fy, cx, cy):
-//   shared_intrinsics = false: R_i (9), C_i (3), K_i (4), R_j (9), C_j (3), K_j (4), (a, b)
-//   shared_intrinsics = true:  R_i (9), C_i (3), R_j (9), C_j (3), K (4), (a, b)
+// ceres::CostFunction with analytic Jacobians. Parameter blocks, with poses
+// as the row-major 3x3 cam_from_world rotation followed by the centre (12
+// values, with NewPoseManifold) and intrinsics as (fx, fy, cx, cy):
+//   shared_intrinsics = false: pose_i (12), K_i (4), pose_j (12), K_j (4), (a, b)
+//   shared_intrinsics = true:  pose_i (12), pose_j (12), K (4), (a, b)
 // and with free_surface a last block (1): the offset δ of the sample's face
 // plane, n·X = plane_offset + δ.
 // `image_j` (CV_32F) must outlive the cost function (its data is shared).
@@ -224,9 +224,13 @@ ceres::CostFunction* NewPhotometricCost(const PhotometricSample& sample, const c
 // Plus(R, δ) = Exp(δ) R (δ an angle-axis vector in the camera frame).
 ceres::Manifold* NewRotationMatrixManifold();
 
+// A pose block (R row-major, C): NewRotationMatrixManifold's update on R and
+// the plain one on C (tangent (δ_R, δ_C), 6 values).
+ceres::Manifold* NewPoseManifold();
+
 // The datum of a camera set against reference cameras (R0_k cam_from_world,
-// C0_k centres; at least 2) as a ceres::CostFunction of the blocks R_0 (9,
-// row-major), C_0 (3), R_1, C_1, ...: 7 residuals, the mean centre shift / sigma_center
+// C0_k centres; at least 2) as a ceres::CostFunction of the cameras' pose
+// blocks (12 values each, as NewPhotometricCost's): 7 residuals, the mean centre shift / sigma_center
 // (scene units), the mean world-frame rotation change vee(skew(R0_kᵀ R_k)) /
 // sigma_rotation (radians) and the relative scale change of the set about
 // its mean centre / sigma_scale, each 0 at the reference and independent of

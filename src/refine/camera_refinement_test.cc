@@ -239,14 +239,15 @@ TEST_F(CameraRefinementTest, PhotometricJacobianMatchesFiniteDifferences) {
                               views[j], render_j, s.images[j], 3000);
   ASSERT_GT(samples.size(), 1000u);
 
-  std::array<double, 9> Ri, Rj;
-  Eigen::Map<RowMatrix3d>(Ri.data()) = views[i].R;
-  Eigen::Map<RowMatrix3d>(Rj.data()) = views[j].R;
-  Eigen::Vector3d Ci = views[i].Center(), Cj = views[j].Center();
+  std::array<double, 12> pose_i, pose_j;  // R row-major, C
+  Eigen::Map<RowMatrix3d>(pose_i.data()) = views[i].R;
+  Eigen::Map<RowMatrix3d>(pose_j.data()) = views[j].R;
+  Eigen::Map<Eigen::Vector3d>(pose_i.data() + 9) = views[i].Center();
+  Eigen::Map<Eigen::Vector3d>(pose_j.data() + 9) = views[j].Center();
   std::array<double, 4> Ki = {views[i].fx, views[i].fy, views[i].cx, views[i].cy};
   std::array<double, 4> Kj = {views[j].fx, views[j].fy, views[j].cx, views[j].cy};
   std::array<double, 2> ab = {1.1, -0.03};
-  std::unique_ptr<ceres::Manifold> rotation(internal::NewRotationMatrixManifold());
+  std::unique_ptr<ceres::Manifold> pose(internal::NewPoseManifold());
 
   // Error per block at 20 samples spread through the list: each below 1e-6
   // (measured at most 1e-9, the round-off of the differences). The bilinear
@@ -255,9 +256,9 @@ TEST_F(CameraRefinementTest, PhotometricJacobianMatchesFiniteDifferences) {
   // by hand that the test fails when one term is altered: the sign of the
   // ray term in ∂X/∂C_i gives errors of 0.6 to 1.6, ∂r/∂f_y of view j off
   // by 0.1 % gives 5e-5, the sign of ∂r/∂δ flipped gives 2.
-  const char* separate_names[] = {"R_i", "C_i", "K_i", "R_j", "C_j", "K_j", "ab", "δ"};
-  const char* shared_names[] = {"R_i", "C_i", "R_j", "C_j", "K", "ab", "δ"};
-  std::vector<std::vector<double>> separate(8), shared(7), fixed_surface(1);
+  const char* separate_names[] = {"pose_i", "K_i", "pose_j", "K_j", "ab", "δ"};
+  const char* shared_names[] = {"pose_i", "pose_j", "K", "ab", "δ"};
+  std::vector<std::vector<double>> separate(6), shared(5), fixed_surface(1);
   // The free surface's plane offset, off 0 (in scene units; the footprint is ~0.013).
   double delta = 0.004;
   for (int k = 0; k < 20; ++k) {
@@ -267,24 +268,23 @@ TEST_F(CameraRefinementTest, PhotometricJacobianMatchesFiniteDifferences) {
     std::unique_ptr<ceres::CostFunction> cost(
         internal::NewPhotometricCost(sample, s.images[j], false, true));
     const std::vector<double> e = JacobianErrors(
-        *cost,
-        {rotation.get(), nullptr, nullptr, rotation.get(), nullptr, nullptr, nullptr, nullptr},
-        {Ri.data(), Ci.data(), Ki.data(), Rj.data(), Cj.data(), Kj.data(), ab.data(), &delta});
-    for (int b = 0; b < 8; ++b) separate[b].push_back(e[b]);
+        *cost, {pose.get(), nullptr, pose.get(), nullptr, nullptr, nullptr},
+        {pose_i.data(), Ki.data(), pose_j.data(), Kj.data(), ab.data(), &delta});
+    for (int b = 0; b < 6; ++b) separate[b].push_back(e[b]);
     std::unique_ptr<ceres::CostFunction> shared_cost(
         internal::NewPhotometricCost(sample, s.images[j], true, true));
-    const std::vector<double> f = JacobianErrors(
-        *shared_cost, {rotation.get(), nullptr, rotation.get(), nullptr, nullptr, nullptr, nullptr},
-        {Ri.data(), Ci.data(), Rj.data(), Cj.data(), Kj.data(), ab.data(), &delta});
-    for (int b = 0; b < 7; ++b) shared[b].push_back(f[b]);
+    const std::vector<double> f =
+        JacobianErrors(*shared_cost, {pose.get(), pose.get(), nullptr, nullptr, nullptr},
+                       {pose_i.data(), pose_j.data(), Kj.data(), ab.data(), &delta});
+    for (int b = 0; b < 5; ++b) shared[b].push_back(f[b]);
     for (bool shared_k : {false, true}) {
       std::unique_ptr<ceres::CostFunction> fixed(
           internal::NewPhotometricCost(sample, s.images[j], shared_k, false));
-      std::vector<double*> blocks = {Ri.data(), Ci.data()};
+      std::vector<double*> blocks = {pose_i.data()};
       if (!shared_k) blocks.push_back(Ki.data());
-      blocks.insert(blocks.end(), {Rj.data(), Cj.data(), Kj.data(), ab.data()});
+      blocks.insert(blocks.end(), {pose_j.data(), Kj.data(), ab.data()});
       std::vector<const ceres::Manifold*> manifolds(blocks.size(), nullptr);
-      manifolds[0] = manifolds[shared_k ? 2 : 3] = rotation.get();
+      manifolds[0] = manifolds[shared_k ? 1 : 2] = pose.get();
       for (double error : JacobianErrors(*fixed, manifolds, blocks)) {
         fixed_surface[0].push_back(error);
       }
@@ -620,30 +620,26 @@ TEST(CameraSetDatum, MeasuresTheSimilarityOfTheSet) {
   ASSERT_EQ(cost->num_residuals(), 7);
   // `motion` maps (R, C) of each camera to its moved pose.
   const auto residuals = [&](const std::function<void(Eigen::Matrix3d*, Eigen::Vector3d*)>& motion,
-                             std::vector<std::array<double, 9>>* R,
-                             std::vector<std::array<double, 3>>* C) {
-    R->resize(n);
-    C->resize(n);
+                             std::vector<std::array<double, 12>>* poses) {
+    poses->resize(n);
     std::vector<double*> blocks;
     for (int k = 0; k < n; ++k) {
       Eigen::Matrix3d Rk = R0[k];
       Eigen::Vector3d Ck = C0[k];
       motion(&Rk, &Ck);
-      Eigen::Map<RowMatrix3d>((*R)[k].data()) = Rk;
-      Eigen::Map<Eigen::Vector3d>((*C)[k].data()) = Ck;
-      blocks.push_back((*R)[k].data());
-      blocks.push_back((*C)[k].data());
+      Eigen::Map<RowMatrix3d>((*poses)[k].data()) = Rk;
+      Eigen::Map<Eigen::Vector3d>((*poses)[k].data() + 9) = Ck;
+      blocks.push_back((*poses)[k].data());
     }
     Eigen::Matrix<double, 7, 1> r;
     EXPECT_TRUE(cost->Evaluate(blocks.data(), r.data(), nullptr));
     return r;
   };
-  std::vector<std::array<double, 9>> R;
-  std::vector<std::array<double, 3>> C;
-  EXPECT_LT(residuals([](Eigen::Matrix3d*, Eigen::Vector3d*) {}, &R, &C).norm(), 1e-12);
+  std::vector<std::array<double, 12>> poses;
+  EXPECT_LT(residuals([](Eigen::Matrix3d*, Eigen::Vector3d*) {}, &poses).norm(), 1e-12);
   const Eigen::Vector3d t(0.01, -0.02, 0.005);
   const Eigen::Matrix<double, 7, 1> shift =
-      residuals([&](Eigen::Matrix3d*, Eigen::Vector3d* c) { *c += t; }, &R, &C);
+      residuals([&](Eigen::Matrix3d*, Eigen::Vector3d* c) { *c += t; }, &poses);
   EXPECT_LT((shift.head<3>() - t / sc).norm(), 1e-9);
   EXPECT_LT(shift.tail<4>().norm(), 1e-9);
   const Eigen::Vector3d w(2e-4, -1e-4, 3e-4);
@@ -653,12 +649,12 @@ TEST(CameraSetDatum, MeasuresTheSimilarityOfTheSet) {
         *r = *r * Q.transpose();
         *c = mean + Q * (*c - mean);
       },
-      &R, &C);
+      &poses);
   EXPECT_LT(turn.head<3>().norm(), 1e-9);
   EXPECT_LT((turn.segment<3>(3) + w / sr).norm(), 1e-6 * w.norm() / sr);
   EXPECT_LT(std::abs(turn(6)), w.squaredNorm() / ss);  // second order: (cos - 1) / ss
   const Eigen::Matrix<double, 7, 1> scale = residuals(
-      [&](Eigen::Matrix3d*, Eigen::Vector3d* c) { *c = mean + 1.002 * (*c - mean); }, &R, &C);
+      [&](Eigen::Matrix3d*, Eigen::Vector3d* c) { *c = mean + 1.002 * (*c - mean); }, &poses);
   EXPECT_LT(scale.head<6>().norm(), 1e-9);
   EXPECT_NEAR(scale(6), 0.002 / ss, 1e-9);
 
@@ -669,46 +665,31 @@ TEST(CameraSetDatum, MeasuresTheSimilarityOfTheSet) {
         *r = ExpRotation(Eigen::Vector3d(gauss(rng), gauss(rng), gauss(rng)) * 0.01) * *r;
         *c += Eigen::Vector3d(gauss(rng), gauss(rng), gauss(rng)) * 0.05;
       },
-      &R, &C);
+      &poses);
   std::vector<double*> blocks;
-  std::vector<Eigen::Matrix<double, 7, Eigen::Dynamic, Eigen::RowMajor>> ambient(2 * n);
+  std::vector<Eigen::Matrix<double, 7, 12, Eigen::RowMajor>> ambient(n);
   std::vector<double*> jacobians;
   for (int k = 0; k < n; ++k) {
-    blocks.push_back(R[k].data());
-    blocks.push_back(C[k].data());
-    ambient[2 * k].resize(7, 9);
-    ambient[2 * k + 1].resize(7, 3);
-    jacobians.push_back(ambient[2 * k].data());
-    jacobians.push_back(ambient[2 * k + 1].data());
+    blocks.push_back(poses[k].data());
+    jacobians.push_back(ambient[k].data());
   }
   Eigen::Matrix<double, 7, 1> r0;
   ASSERT_TRUE(cost->Evaluate(blocks.data(), r0.data(), jacobians.data()));
-  std::unique_ptr<ceres::Manifold> manifold(internal::NewRotationMatrixManifold());
+  std::unique_ptr<ceres::Manifold> manifold(internal::NewPoseManifold());
   double worst = 0;
-  for (int b = 0; b < 2 * n; ++b) {
-    const bool rotation = b % 2 == 0;
-    Eigen::Matrix<double, 7, 3> analytic;
-    if (rotation) {
-      Eigen::Matrix<double, 9, 3, Eigen::RowMajor> plus;
-      manifold->PlusJacobian(blocks[b], plus.data());
-      analytic = ambient[b] * plus;
-    } else {
-      analytic = ambient[b];
-    }
-    Eigen::Matrix<double, 7, 3> numeric;
-    const std::vector<double> x(blocks[b], blocks[b] + (rotation ? 9 : 3));
-    for (int k = 0; k < 3; ++k) {
+  for (int b = 0; b < n; ++b) {
+    Eigen::Matrix<double, 12, 6, Eigen::RowMajor> plus;
+    manifold->PlusJacobian(blocks[b], plus.data());
+    const Eigen::Matrix<double, 7, 6> analytic = ambient[b] * plus;
+    Eigen::Matrix<double, 7, 6> numeric;
+    const std::vector<double> x(blocks[b], blocks[b] + 12);
+    for (int k = 0; k < 6; ++k) {
       Eigen::Matrix<double, 7, 1> r[2];
       const double h = 1e-6;
       for (int side = 0; side < 2; ++side) {
-        const double sign = side == 0 ? 1.0 : -1.0;
-        if (rotation) {
-          double delta[3] = {0, 0, 0};
-          delta[k] = sign * h;
-          manifold->Plus(x.data(), delta, blocks[b]);
-        } else {
-          blocks[b][k] = x[k] + sign * h;
-        }
+        double delta[6] = {0, 0, 0, 0, 0, 0};
+        delta[k] = (side == 0 ? 1.0 : -1.0) * h;
+        manifold->Plus(x.data(), delta, blocks[b]);
         ASSERT_TRUE(cost->Evaluate(blocks.data(), r[side].data(), nullptr));
         std::copy(x.begin(), x.end(), blocks[b]);
       }
