@@ -25,7 +25,9 @@
 // samples on face f from every pair and held near 0 by a prior of
 // surface_sigma_px pixel footprints: a photometric bundle adjustment whose
 // structure is the mesh's face planes. The cameras are then fixed by what the
-// views agree on, not by the mesh's depth.
+// views agree on, not by the mesh's depth. The frame the fixed mesh held is
+// then held by a datum residual: the camera set's mean shift, rotation and
+// scale stay at the prior views' (datum_sigma_px).
 // The photometric Jacobian is analytic (see docs/camera_refinement.md).
 
 #include <Eigen/Core>

@@ -151,7 +151,7 @@ struct RefineOptions {
   // camera). The level's images of all views are held at once for it; a
   // level whose images would take more than half of cache_mb is not refined
   // (logged). Default "none": on the corpus it helps where the cameras are
-  // 0.5-2 px off, but with exact cameras it costs 1-3 % of accuracy90 and
+  // 0.5-2 px off, but with exact cameras it costs 1-3.5 % of accuracy90 and
   // on COLMAP's own cameras of templeSparseRing it lowers the held-out
   // photo-consistency a little (0.625 -> 0.612; docs/camera_refinement.md).
   std::string refine_cameras = "none";
