@@ -690,6 +690,41 @@ std::vector<OrderedPair> CollectSamples(const std::vector<cv::Mat>& gray_images,
   return ordered;
 }
 
+// The refined views as the datum sees them: their prior cameras, their pose
+// blocks in `params`, their mean footprint and focal length, and the RMS
+// distance of the prior centres from their mean.
+struct DatumViews {
+  std::vector<Eigen::Matrix3d> R0;
+  std::vector<Eigen::Vector3d> C0;
+  std::vector<double*> blocks;
+  double mean_footprint = 0, mean_focal = 0, radius = 0;
+};
+
+DatumViews GatherDatumViews(const CameraParameters& prior, const std::vector<char>& refined,
+                            const std::vector<double>& footprint, CameraParameters* params) {
+  DatumViews d;
+  for (size_t i = 0; i < refined.size(); ++i) {
+    if (!refined[i]) continue;
+    d.R0.push_back(Eigen::Map<const internal::RowMatrix3d>(prior.pose[i].data()));
+    d.C0.push_back(Eigen::Map<const Eigen::Vector3d>(prior.pose[i].data() + 9));
+    d.blocks.push_back(params->pose[i].data());
+    d.mean_footprint += footprint[i];
+    const std::array<double, 4>& k = prior.intrinsics[prior.block_of_view[i]];
+    d.mean_focal += 0.5 * (k[0] + k[1]);
+  }
+  if (d.C0.empty()) return d;
+  const double n = static_cast<double>(d.C0.size());
+  d.mean_footprint /= n;
+  d.mean_focal /= n;
+  Eigen::Vector3d mean_center = Eigen::Vector3d::Zero();
+  for (const Eigen::Vector3d& c : d.C0) mean_center += c;
+  mean_center /= n;
+  double spread = 0;
+  for (const Eigen::Vector3d& c : d.C0) spread += (c - mean_center).squaredNorm();
+  d.radius = std::sqrt(spread / n);
+  return d;
+}
+
 // The least-squares problem over `params` (which it points into): the
 // photometric residuals of every sample and the priors of every view (and
 // camera) they involve, centred on `prior` (same layout as `params`).
@@ -774,38 +809,15 @@ void BuildProblem(const std::vector<cv::Mat>& gray_images, const std::vector<Ord
   }
   // The datum of the refined set, held at the prior views' when the surface
   // is free (a fixed mesh, or fixed views, hold it themselves).
-  std::vector<int> datum_views;
-  for (size_t i = 0; i < refined->size(); ++i) {
-    if ((*refined)[i]) datum_views.push_back(static_cast<int>(i));
-  }
   const bool any_fixed = std::find(fixed.begin(), fixed.end(), 1) != fixed.end();
-  if (free_surface && options.datum_sigma_px > 0 && !any_fixed && datum_views.size() >= 2) {
-    std::vector<Eigen::Matrix3d> R0;
-    std::vector<Eigen::Vector3d> C0;
-    std::vector<double*> blocks;
-    double mean_footprint = 0, mean_focal = 0;
-    for (int i : datum_views) {
-      R0.push_back(Eigen::Map<const internal::RowMatrix3d>(prior.pose[i].data()));
-      C0.push_back(Eigen::Map<const Eigen::Vector3d>(prior.pose[i].data() + 9));
-      blocks.push_back(p.pose[i].data());
-      mean_footprint += footprint[i];
-      const std::array<double, 4>& k = prior.intrinsics[prior.block_of_view[i]];
-      mean_focal += 0.5 * (k[0] + k[1]);
-    }
-    mean_footprint /= datum_views.size();
-    mean_focal /= datum_views.size();
-    Eigen::Vector3d mean_center = Eigen::Vector3d::Zero();
-    for (const Eigen::Vector3d& c : C0) mean_center += c;
-    mean_center /= static_cast<double>(C0.size());
-    double spread = 0;
-    for (const Eigen::Vector3d& c : C0) spread += (c - mean_center).squaredNorm();
-    const double radius = std::sqrt(spread / C0.size());
-    if (radius > 0) {
+  if (free_surface && options.datum_sigma_px > 0 && !any_fixed) {
+    const DatumViews d = GatherDatumViews(prior, *refined, footprint, params);
+    if (d.C0.size() >= 2 && d.radius > 0) {
       const double sigma = options.datum_sigma_px;
       problem->AddResidualBlock(
-          internal::NewCameraSetDatumCost(R0, C0, sigma * mean_footprint, sigma / mean_focal,
-                                          sigma * mean_footprint / radius),
-          nullptr, blocks);
+          internal::NewCameraSetDatumCost(d.R0, d.C0, sigma * d.mean_footprint,
+                                          sigma / d.mean_focal, sigma * d.mean_footprint / d.radius),
+          nullptr, d.blocks);
     }
   }
   std::vector<char> fixed_block(p.intrinsics.size(), 0);
@@ -952,28 +964,17 @@ CameraRefinementSummary RefineCameras(const std::vector<cv::Mat>& gray_images,
     return summary;
   }
   WriteBack(params, refined, intrinsics, views, &summary);
-  {
-    std::vector<Eigen::Matrix3d> R0;
-    std::vector<Eigen::Vector3d> C0;
-    std::vector<const double*> blocks;
-    double mean_footprint = 0;
-    for (int i = 0; i < num_views; ++i) {
-      if (!refined[i]) continue;
-      R0.push_back(Eigen::Map<const internal::RowMatrix3d>(prior.pose[i].data()));
-      C0.push_back(Eigen::Map<const Eigen::Vector3d>(prior.pose[i].data() + 9));
-      blocks.push_back(params.pose[i].data());
-      mean_footprint += summary.footprint[i];
-    }
-    if (C0.size() >= 2) {
-      mean_footprint /= C0.size();
-      std::unique_ptr<ceres::CostFunction> datum(
-          internal::NewCameraSetDatumCost(R0, C0, mean_footprint, kDegree, 1.0));
-      double r[7];
-      datum->Evaluate(blocks.data(), r, nullptr);
-      summary.set_shift_px = Eigen::Vector3d(r[0], r[1], r[2]).norm();
-      summary.set_rotation_deg = Eigen::Vector3d(r[3], r[4], r[5]).norm();
-      summary.set_scale_change = r[6];
-    }
+  // How far the set moved: the datum residuals in footprints, degrees and
+  // relative scale.
+  if (const DatumViews d = GatherDatumViews(prior, refined, summary.footprint, &params);
+      d.C0.size() >= 2) {
+    std::unique_ptr<ceres::CostFunction> datum(
+        internal::NewCameraSetDatumCost(d.R0, d.C0, d.mean_footprint, kDegree, 1.0));
+    double r[7];
+    datum->Evaluate(d.blocks.data(), r, nullptr);
+    summary.set_shift_px = Eigen::Vector3d(r[0], r[1], r[2]).norm();
+    summary.set_rotation_deg = Eigen::Vector3d(r[3], r[4], r[5]).norm();
+    summary.set_scale_change = r[6];
   }
   std::vector<double> offsets_px;
   for (size_t f = 0; f < params.surface_sigma.size(); ++f) {
