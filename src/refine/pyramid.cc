@@ -57,26 +57,23 @@ inline double At(const cv::Mat& img, int r, int c) {
   return static_cast<double>(img.ptr<T>(r)[c]);
 }
 
+// Index coordinate (pixel centres at integers) of image coordinate x along an
+// axis of `size` pixels, clamped to [0, size - 1]; `clamped` tells whether it
+// was (NaN included).
+double IndexCoordinate(double x, int size, bool* clamped) {
+  const double u = x - 0.5;
+  *clamped = true;
+  if (!(u >= 0)) return 0;  // also NaN
+  if (u > size - 1) return size - 1;
+  *clamped = false;
+  return u;
+}
+
 template <typename T>
 double SampleTyped(const cv::Mat& img, double x, double y, Eigen::Vector2d* grad) {
-  // Index coordinates: pixel centres at integers.
-  double u = x - 0.5, v = y - 0.5;
-  const double umax = img.cols - 1, vmax = img.rows - 1;
-  bool clamp_u = false, clamp_v = false;
-  if (!(u >= 0)) {  // also NaN
-    u = 0;
-    clamp_u = true;
-  } else if (u > umax) {
-    u = umax;
-    clamp_u = true;
-  }
-  if (!(v >= 0)) {
-    v = 0;
-    clamp_v = true;
-  } else if (v > vmax) {
-    v = vmax;
-    clamp_v = true;
-  }
+  bool clamp_u, clamp_v;
+  const double u = IndexCoordinate(x, img.cols, &clamp_u);
+  const double v = IndexCoordinate(y, img.rows, &clamp_v);
   int c0 = std::min(static_cast<int>(u), std::max(img.cols - 2, 0));
   int r0 = std::min(static_cast<int>(v), std::max(img.rows - 2, 0));
   const int c1 = std::min(c0 + 1, img.cols - 1);
@@ -92,6 +89,117 @@ double SampleTyped(const cv::Mat& img, double x, double y, Eigen::Vector2d* grad
     (*grad)(1) = clamp_v ? 0.0 : bottom - top;
   }
   return top + fv * (bottom - top);
+}
+
+
+// Catmull-Rom weights of the taps at offsets -1, 0, 1, 2 from the cell's
+// first pixel, for the fraction t in [0, 1], and their derivatives in t.
+void CubicWeights(double t, double w[4], double dw[4]) {
+  const double t2 = t * t, t3 = t2 * t;
+  w[0] = 0.5 * (-t3 + 2 * t2 - t);
+  w[1] = 0.5 * (3 * t3 - 5 * t2 + 2);
+  w[2] = 0.5 * (-3 * t3 + 4 * t2 + t);
+  w[3] = 0.5 * (t3 - t2);
+  dw[0] = 0.5 * (-3 * t2 + 4 * t - 1);
+  dw[1] = 0.5 * (9 * t2 - 10 * t);
+  dw[2] = 0.5 * (-9 * t2 + 8 * t + 1);
+  dw[3] = 0.5 * (3 * t2 - 2 * t);
+}
+
+template <typename T>
+double SampleCubicTyped(const cv::Mat& img, double x, double y, Eigen::Vector2d* grad) {
+  bool clamp_u, clamp_v;
+  const double u = IndexCoordinate(x, img.cols, &clamp_u);
+  const double v = IndexCoordinate(y, img.rows, &clamp_v);
+  const int c0 = std::min(static_cast<int>(u), img.cols - 1);
+  const int r0 = std::min(static_cast<int>(v), img.rows - 1);
+  double wu[4], dwu[4], wv[4], dwv[4];
+  CubicWeights(u - c0, wu, dwu);
+  CubicWeights(v - r0, wv, dwv);
+  int cols[4];
+  for (int k = 0; k < 4; ++k) cols[k] = std::clamp(c0 - 1 + k, 0, img.cols - 1);
+  double value = 0, du = 0, dv = 0;
+  for (int i = 0; i < 4; ++i) {
+    const T* row = img.ptr<T>(std::clamp(r0 - 1 + i, 0, img.rows - 1));
+    double along = 0, d_along = 0;
+    for (int k = 0; k < 4; ++k) {
+      const double p = static_cast<double>(row[cols[k]]);
+      along += wu[k] * p;
+      d_along += dwu[k] * p;
+    }
+    value += wv[i] * along;
+    du += wv[i] * d_along;
+    dv += dwv[i] * along;
+  }
+  if (grad != nullptr) {
+    (*grad)(0) = clamp_u ? 0.0 : du;
+    (*grad)(1) = clamp_v ? 0.0 : dv;
+  }
+  return value;
+}
+
+// The taps along one axis of `size` pixels of the mean of the cubic
+// interpolants at x - sigma and x + sigma (x alone for sigma 0): weights of
+// the pixels first .. first + count - 1 (replicated beyond the border) and
+// their derivatives in x (0 for a point clamped to the border).
+struct AxisTaps {
+  static constexpr int kMax = 12;
+  int first = 0;
+  int count = 0;
+  double w[kMax] = {};
+  double dw[kMax] = {};
+};
+
+AxisTaps BlurredCubicTaps(double x, int size, double sigma, bool with_derivative) {
+  const int points = sigma > 0 ? 2 : 1;
+  const double positions[2] = {x - sigma, x + sigma};
+  int c0[2];
+  double fraction[2];
+  bool clamped[2];
+  for (int p = 0; p < points; ++p) {
+    const double u = IndexCoordinate(points == 1 ? x : positions[p], size, &clamped[p]);
+    c0[p] = std::min(static_cast<int>(u), size - 1);
+    fraction[p] = u - c0[p];
+  }
+  AxisTaps taps;
+  taps.first = c0[0] - 1;
+  taps.count = c0[points - 1] + 3 - taps.first;
+  MR_CHECK_LE(taps.count, AxisTaps::kMax) << "SampleCubicBlurred: sigma too large";
+  for (int p = 0; p < points; ++p) {
+    double w[4], dw[4];
+    CubicWeights(fraction[p], w, dw);
+    const int offset = c0[p] - 1 - taps.first;
+    for (int k = 0; k < 4; ++k) taps.w[offset + k] += w[k] / points;
+    if (with_derivative && !clamped[p]) {
+      for (int k = 0; k < 4; ++k) taps.dw[offset + k] += dw[k] / points;
+    }
+  }
+  return taps;
+}
+
+template <typename T>
+double SampleCubicBlurredTyped(const cv::Mat& img, double x, double y, double sigma,
+                               Eigen::Vector2d* grad) {
+  if (sigma <= 0) return SampleCubicTyped<T>(img, x, y, grad);
+  const bool with_derivative = grad != nullptr;
+  const AxisTaps tx = BlurredCubicTaps(x, img.cols, sigma, with_derivative);
+  const AxisTaps ty = BlurredCubicTaps(y, img.rows, sigma, with_derivative);
+  int cols[AxisTaps::kMax];
+  for (int k = 0; k < tx.count; ++k) cols[k] = std::clamp(tx.first + k, 0, img.cols - 1);
+  double value = 0, du = 0, dv = 0;
+  for (int i = 0; i < ty.count; ++i) {
+    const T* row = img.ptr<T>(std::clamp(ty.first + i, 0, img.rows - 1));
+    double along = 0;
+    for (int k = 0; k < tx.count; ++k) along += tx.w[k] * static_cast<double>(row[cols[k]]);
+    value += ty.w[i] * along;
+    if (!with_derivative) continue;
+    double d_along = 0;
+    for (int k = 0; k < tx.count; ++k) d_along += tx.dw[k] * static_cast<double>(row[cols[k]]);
+    du += ty.w[i] * d_along;
+    dv += ty.dw[i] * along;
+  }
+  if (grad != nullptr) *grad = Eigen::Vector2d(du, dv);
+  return value;
 }
 
 }  // namespace
@@ -153,6 +261,40 @@ double SampleBilinear(const cv::Mat& img, double x, double y, Eigen::Vector2d* g
       return SampleTyped<double>(img, x, y, grad);
     default:
       MR_CHECK(false) << "SampleBilinear: image depth must be CV_8U, CV_32F or CV_64F";
+  }
+  return 0;
+}
+
+double SampleCubic(const cv::Mat& img, double x, double y, Eigen::Vector2d* grad) {
+  MR_CHECK(!img.empty() && img.channels() == 1)
+      << "SampleCubic: expected a non-empty single-channel image";
+  switch (img.depth()) {
+    case CV_8U:
+      return SampleCubicTyped<uchar>(img, x, y, grad);
+    case CV_32F:
+      return SampleCubicTyped<float>(img, x, y, grad);
+    case CV_64F:
+      return SampleCubicTyped<double>(img, x, y, grad);
+    default:
+      MR_CHECK(false) << "SampleCubic: image depth must be CV_8U, CV_32F or CV_64F";
+  }
+  return 0;
+}
+
+double SampleCubicBlurred(const cv::Mat& img, double x, double y, double sigma,
+                          Eigen::Vector2d* grad) {
+  MR_CHECK(!img.empty() && img.channels() == 1)
+      << "SampleCubicBlurred: expected a non-empty single-channel image";
+  MR_CHECK(sigma >= 0 && sigma <= 3) << "SampleCubicBlurred: sigma " << sigma << " not in [0, 3]";
+  switch (img.depth()) {
+    case CV_8U:
+      return SampleCubicBlurredTyped<uchar>(img, x, y, sigma, grad);
+    case CV_32F:
+      return SampleCubicBlurredTyped<float>(img, x, y, sigma, grad);
+    case CV_64F:
+      return SampleCubicBlurredTyped<double>(img, x, y, sigma, grad);
+    default:
+      MR_CHECK(false) << "SampleCubicBlurred: image depth must be CV_8U, CV_32F or CV_64F";
   }
   return 0;
 }

@@ -1,6 +1,6 @@
 #pragma once
 
-// Gaussian image pyramids and bilinear sampling, in COLMAP's image
+// Gaussian image pyramids and bilinear and cubic sampling, in COLMAP's image
 // coordinates: the centre of pixel (column c, row r) is the image point
 // (c + 0.5, r + 0.5), so the image covers [0, width] x [0, height].
 //
@@ -57,5 +57,20 @@ PinholeView PyramidLevelView(const PinholeView& view, int level);
 // (optional) receives (d/dx, d/dy) of the interpolant; on cell borders it is
 // one-sided (from the cell to the right / below, or the last cell).
 double SampleBilinear(const cv::Mat& img, double x, double y, Eigen::Vector2d* grad = nullptr);
+
+// Cubic convolution (Keys, a = -0.5: Catmull-Rom) of the same images at the
+// same points, with the same clamping. The 4x4 stencil replicates the border
+// pixels. Unlike the bilinear interpolant, this one is C1 (its gradient is
+// continuous) and reproduces quadratics, so it blurs fine texture less and
+// less unevenly: the bilinear interpolant averages two pixels half way
+// between them and none at a pixel centre.
+double SampleCubic(const cv::Mat& img, double x, double y, Eigen::Vector2d* grad = nullptr);
+
+// The mean of SampleCubic at the four points (x ± sigma, y ± sigma) (each
+// clamped as SampleCubic clamps it), a blur of variance sigma² per axis on
+// top of the interpolation, and its gradient; computed as one separable
+// stencil of up to 4 + 2 sigma + 1 taps per axis. 0 <= sigma <= 3.
+double SampleCubicBlurred(const cv::Mat& img, double x, double y, double sigma,
+                          Eigen::Vector2d* grad = nullptr);
 
 }  // namespace mr

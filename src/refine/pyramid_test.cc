@@ -219,5 +219,131 @@ TEST(SampleBilinear, RejectsMultiChannel) {
   EXPECT_THROW(SampleBilinear(img, 1, 1), InternalError);
 }
 
+TEST(SampleCubic, ExactAtPixelCentresAndOnQuadratics) {
+  cv::Mat img(5, 7, CV_64F);
+  cv::randu(img, 0.0, 1.0);
+  for (int r = 0; r < 5; ++r)
+    for (int c = 0; c < 7; ++c) {
+      EXPECT_NEAR(SampleCubic(img, c + 0.5, r + 0.5), img.at<double>(r, c), 1e-15);
+    }
+  // f = (x - 3)^2 - 2 x y + 0.5 y^2 at the pixel centres; the interpolant and
+  // its gradient are exact wherever the 4x4 stencil is inside the image.
+  auto f = [](double x, double y) { return (x - 3) * (x - 3) - 2 * x * y + 0.5 * y * y; };
+  cv::Mat quad(8, 9, CV_64F);
+  for (int r = 0; r < quad.rows; ++r)
+    for (int c = 0; c < quad.cols; ++c) quad.at<double>(r, c) = f(c + 0.5, r + 0.5);
+  std::mt19937 rng(3);
+  std::uniform_real_distribution<double> ux(1.5, 7.5), uy(1.5, 6.5);
+  for (int i = 0; i < 100; ++i) {
+    const double x = ux(rng), y = uy(rng);
+    Eigen::Vector2d g;
+    EXPECT_NEAR(SampleCubic(quad, x, y, &g), f(x, y), 1e-11) << x << " " << y;
+    EXPECT_NEAR(g.x(), 2 * (x - 3) - 2 * y, 1e-11);
+    EXPECT_NEAR(g.y(), -2 * x + y, 1e-11);
+  }
+}
+
+TEST(SampleCubic, GradientMatchesFiniteDifferencesAndIsContinuous) {
+  cv::Mat img(9, 11, CV_64F);
+  cv::randu(img, 0.0, 1.0);
+  cv::Mat f, u8;
+  img.convertTo(f, CV_32F);
+  img.convertTo(u8, CV_8U, 255.0);
+  std::mt19937 rng(2);
+  std::uniform_real_distribution<double> ux(0.5, 10.5), uy(0.5, 8.5);
+  const double h = 1e-6;
+  for (int i = 0; i < 200; ++i) {
+    const double x = ux(rng), y = uy(rng);
+    for (const cv::Mat* m : {&img, &f, &u8}) {
+      Eigen::Vector2d g;
+      const double v = SampleCubic(*m, x, y, &g);
+      EXPECT_DOUBLE_EQ(v, SampleCubic(*m, x, y));
+      const double gx = (SampleCubic(*m, x + h, y) - SampleCubic(*m, x - h, y)) / (2 * h);
+      const double gy = (SampleCubic(*m, x, y + h) - SampleCubic(*m, x, y - h)) / (2 * h);
+      const double scale = m == &u8 ? 255.0 : 1.0;
+      EXPECT_NEAR(g.x(), gx, 1e-5 * scale);
+      EXPECT_NEAR(g.y(), gy, 1e-5 * scale);
+    }
+  }
+  // Across a cell border the gradient has no jump (the bilinear one does).
+  for (int c = 1; c < 10; ++c) {
+    Eigen::Vector2d left, right, bl, br;
+    SampleCubic(img, c + 0.5 - 1e-9, 4.3, &left);
+    SampleCubic(img, c + 0.5 + 1e-9, 4.3, &right);
+    EXPECT_NEAR(left.x(), right.x(), 1e-6) << c;
+    SampleBilinear(img, c + 0.5 - 1e-9, 4.3, &bl);
+    SampleBilinear(img, c + 0.5 + 1e-9, 4.3, &br);
+    EXPECT_GT(std::abs(bl.x() - br.x()), 1e-3) << c;  // the test can tell a jump
+  }
+}
+
+TEST(SampleCubic, KeepsFineTextureThatBilinearBlurs) {
+  // A cosine of period 3 pixels along x, sampled half way between pixel
+  // centres. The interpolants' gains there are those of their taps at that
+  // frequency (w = 2 pi / 3): bilinear (1/2, 1/2): cos(w / 2) = 0.5; cubic
+  // (-1/16, 9/16, 9/16, -1/16): 9/8 cos(w / 2) - 1/8 cos(3 w / 2) = 0.6875.
+  const double period = 3.0;
+  cv::Mat img(4, 40, CV_64F);
+  for (int c = 0; c < img.cols; ++c) img.col(c).setTo(std::cos(2 * M_PI * (c + 0.5) / period));
+  double cubic = 0, bilinear = 0, truth = 0;
+  for (int c = 5; c < 35; ++c) {
+    const double x = c + 1.0;  // half way between the centres c + 0.5 and c + 1.5
+    const double t = std::cos(2 * M_PI * x / period);
+    truth += t * t;
+    cubic += SampleCubic(img, x, 2.0) * t;
+    bilinear += SampleBilinear(img, x, 2.0) * t;
+  }
+  EXPECT_NEAR(bilinear / truth, 0.5, 1e-9);
+  EXPECT_NEAR(cubic / truth, 0.6875, 1e-9);
+}
+
+TEST(SampleCubic, ImageBorder) {
+  const cv::Mat img = Ramp(6, 4, CV_64F, 0.0, 1.0, 10.0);  // f = x + 10 y
+  Eigen::Vector2d g;
+  // Between the last pixel centre and the image edge: clamped to the centre,
+  // no gradient across the border; the replicated stencil bends the ramp
+  // only in the outermost cells.
+  EXPECT_NEAR(SampleCubic(img, 5.9, 2.0, &g), 5.5 + 20, 1e-12);
+  EXPECT_EQ(g.x(), 0.0);
+  EXPECT_NEAR(g.y(), 10.0, 1e-12);
+  EXPECT_NEAR(SampleCubic(img, -100, 100, &g), 0.5 + 35, 1e-12);
+  EXPECT_EQ(g.norm(), 0.0);
+  EXPECT_NEAR(SampleCubic(img, 3.2, 2.0), 3.2 + 20, 1e-12);
+  const cv::Mat one(1, 1, CV_32F, cv::Scalar(0.25f));
+  EXPECT_EQ(SampleCubic(one, 0.7, 0.2, &g), 0.25);
+  EXPECT_EQ(g.norm(), 0.0);
+  const cv::Mat multi(4, 4, CV_32FC3, cv::Scalar(0, 0, 0));
+  EXPECT_THROW(SampleCubic(multi, 1, 1), InternalError);
+}
+
+TEST(SampleCubicBlurred, IsTheMeanOfFourCubicSamples) {
+  cv::Mat img(12, 15, CV_64F);
+  cv::randu(img, 0.0, 1.0);
+  cv::Mat f;
+  img.convertTo(f, CV_32F);
+  std::mt19937 rng(5);
+  // Points across the whole image and beyond its border, where some of the
+  // four points are clamped and others not.
+  std::uniform_real_distribution<double> ux(-1.0, 16.0), uy(-1.0, 13.0), us(0.0, 3.0);
+  for (int i = 0; i < 300; ++i) {
+    const double x = ux(rng), y = uy(rng), sigma = i % 10 == 0 ? 0.0 : us(rng);
+    for (const cv::Mat* m : {&img, &f}) {
+      double mean = 0;
+      Eigen::Vector2d mean_grad = Eigen::Vector2d::Zero(), g;
+      for (const double dy : {-sigma, sigma}) {
+        for (const double dx : {-sigma, sigma}) {
+          mean += 0.25 * SampleCubic(*m, x + dx, y + dy, &g);
+          mean_grad += 0.25 * g;
+        }
+      }
+      Eigen::Vector2d grad;
+      EXPECT_NEAR(SampleCubicBlurred(*m, x, y, sigma, &grad), mean, 1e-12) << x << " " << y;
+      EXPECT_NEAR(grad.x(), mean_grad.x(), 1e-12) << x << " " << y << " " << sigma;
+      EXPECT_NEAR(grad.y(), mean_grad.y(), 1e-12) << x << " " << y << " " << sigma;
+    }
+  }
+  EXPECT_THROW(SampleCubicBlurred(img, 3, 3, 3.5), InternalError);
+}
+
 }  // namespace
 }  // namespace mr
