@@ -74,6 +74,50 @@ bool WarpPixel(const MeshGeometry& mesh, const PinholeView& view_i, const Render
   return true;
 }
 
+// s = sqrt|det ∂q/∂p|: how many pixels of view j (per axis) one pixel of
+// view i covers, through the plane (normal n) of the face it sees. The ray
+// x(p) = C_i + d(p) r(p) meets the plane, so ∂x/∂p_k = d (e_k - r (n·e_k) / (n·r)),
+// e_k = ∂r/∂p_k (`dray`, the columns of R_iᵀ over fx and fy).
+double FootprintRatio(const Eigen::Matrix<double, 3, 2>& dray, const Eigen::Vector3d& n,
+                      const PixelWarp& warp) {
+  const double inv_nr = 1.0 / n.dot(warp.ray);
+  Eigen::Matrix2d J;
+  for (int k = 0; k < 2; ++k) {
+    const Eigen::Vector3d dx =
+        warp.depth * (dray.col(k) - warp.ray * (n.dot(dray.col(k)) * inv_nr));
+    J.col(k) = warp.jacobian_j * dx;
+  }
+  return std::sqrt(std::abs(J(0, 0) * J(1, 1) - J(0, 1) * J(1, 0)));
+}
+
+// Standard deviation (pixels of the sharper view) of the blur that brings a
+// view whose pixels are `ratio` times finer on the surface to the coarser
+// one's: the difference of two box variances, (ratio² - 1) / 12. Below
+// 0.1 pixel (ratio < 1.06) none: an eighth of a pixel's own variance; at
+// most 3 pixels (ratio 10.4; min_cos_angle keeps ratios below about 7).
+double MatchingBlurPx(double ratio) {
+  const double sigma = ratio > 1 ? std::sqrt((ratio * ratio - 1) / 12) : 0.0;
+  return sigma < 0.1 ? 0.0 : std::min(sigma, 3.0);
+}
+
+// `image` at (x, y) blurred by sigma pixels (the mean of the four points at
+// ±sigma along each axis), interpolated as `cubic` says; sigma 0: one sample.
+double SampleBlurred(const cv::Mat& image, double x, double y, double sigma, bool cubic,
+                     Eigen::Vector2d* grad) {
+  if (cubic) return SampleCubicBlurred(image, x, y, sigma, grad);
+  if (sigma <= 0) return SampleBilinear(image, x, y, grad);
+  double sum = 0;
+  Eigen::Vector2d g_sum = Eigen::Vector2d::Zero(), g;
+  for (const double dy : {-sigma, sigma}) {
+    for (const double dx : {-sigma, sigma}) {
+      sum += SampleBilinear(image, x + dx, y + dy, grad != nullptr ? &g : nullptr);
+      if (grad != nullptr) g_sum += g;
+    }
+  }
+  if (grad != nullptr) *grad = 0.25 * g_sum;
+  return 0.25 * sum;
+}
+
 }  // namespace
 
 bool PairTermOptions::Check() const {
@@ -84,6 +128,10 @@ bool PairTermOptions::Check() const {
   if (!(min_cos_angle >= 0 && min_cos_angle < 1)) {
     MR_THROW_INPUT << "PairTermOptions::min_cos_angle = " << min_cos_angle
                    << ". Violated constraint: 0 <= min_cos_angle < 1";
+  }
+  if (interpolation != "cubic" && interpolation != "bilinear") {
+    MR_THROW_INPUT << "PairTermOptions::interpolation = " << interpolation
+                   << ". Violated constraint: interpolation is cubic or bilinear";
   }
   return true;
 }
@@ -137,11 +185,13 @@ cv::Rect ForegroundBox(const RenderBuffers& render) {
 // view i (the maps are box-sized): Î_ij, the valid domain, and, when
 // `derivative` is given, per valid pixel the change of Î per unit motion of
 // the surface along its normal, a = ∇I_jᵀ Jπ_j r / (n·r), and the pixel's
-// footprint d / fx (both CV_64F).
+// footprint d / fx (both CV_64F). With `blur_i` (resolution matching), Î is
+// blurred where view j is finer, and blur_i (CV_32F) receives the blur image
+// i needs where view j is coarser (pixels of i; 0 elsewhere).
 void WarpImage(const MeshGeometry& mesh, const PinholeView& view_i, const RenderBuffers& render_i,
                const PinholeView& view_j, const RenderBuffers& render_j, const cv::Mat& image_j,
                const PairTermOptions& options, const cv::Rect& box, cv::Mat* predicted,
-               cv::Mat* mask, cv::Mat* derivative, cv::Mat* footprint) {
+               cv::Mat* mask, cv::Mat* derivative, cv::Mat* footprint, cv::Mat* blur_i) {
   MR_CHECK(image_j.type() == CV_32F) << "image_j must be CV_32F";
   MR_CHECK(render_i.width == view_i.width && render_i.height == view_i.height);
   MR_CHECK(render_j.width == view_j.width && render_j.height == view_j.height);
@@ -150,6 +200,11 @@ void WarpImage(const MeshGeometry& mesh, const PinholeView& view_i, const Render
   // domain), not zeroed on one thread first.
   predicted->create(box.size(), CV_64F);
   mask->create(box.size(), CV_8U);
+  if (blur_i != nullptr) blur_i->create(box.size(), CV_32F);
+  const bool cubic = options.interpolation == "cubic";
+  Eigen::Matrix<double, 3, 2> dray;  // ∂r/∂p, the same for every pixel of view i
+  dray.col(0) = view_i.R.row(0).transpose() / view_i.fx;
+  dray.col(1) = view_i.R.row(1).transpose() / view_i.fy;
   if (derivative != nullptr) {
     derivative->create(box.size(), CV_64F);
     footprint->create(box.size(), CV_64F);
@@ -159,6 +214,7 @@ void WarpImage(const MeshGeometry& mesh, const PinholeView& view_i, const Render
     const int row = box.y + r;
     predicted->row(r).setTo(0);
     mask->row(r).setTo(0);
+    if (blur_i != nullptr) blur_i->row(r).setTo(0);
     if (derivative != nullptr) {
       derivative->row(r).setTo(0);
       footprint->row(r).setTo(0);
@@ -168,12 +224,18 @@ void WarpImage(const MeshGeometry& mesh, const PinholeView& view_i, const Render
       const int col = box.x + c;
       if (!WarpPixel(mesh, view_i, render_i, view_j, render_j, options, row, col, &warp)) continue;
       mask->at<uint8_t>(r, c) = 255;
-      Eigen::Vector2d grad_j;
-      predicted->at<double>(r, c) = SampleBilinear(image_j, warp.q.x(), warp.q.y(),
-                                                   derivative != nullptr ? &grad_j : nullptr);
-      if (derivative == nullptr) continue;
       const int f = render_i.face_id[static_cast<size_t>(row) * render_i.width + col];
       const Eigen::Vector3d n = mesh.face_normals.row(f);
+      double blur_j = 0;
+      if (blur_i != nullptr) {
+        const double ratio = FootprintRatio(dray, n, warp);
+        blur_j = MatchingBlurPx(ratio);
+        blur_i->at<float>(r, c) = static_cast<float>(MatchingBlurPx(1 / ratio));
+      }
+      Eigen::Vector2d grad_j;
+      predicted->at<double>(r, c) = SampleBlurred(image_j, warp.q.x(), warp.q.y(), blur_j, cubic,
+                                                  derivative != nullptr ? &grad_j : nullptr);
+      if (derivative == nullptr) continue;
       derivative->at<double>(r, c) = grad_j.dot(warp.jacobian_j * warp.ray) / n.dot(warp.ray);
       footprint->at<double>(r, c) = warp.depth / view_i.fx;
     }
@@ -187,7 +249,8 @@ void PredictImage(const MeshGeometry& mesh, const PinholeView& view_i,
                   const RenderBuffers& render_j, const cv::Mat& image_j,
                   const PairTermOptions& options, cv::Mat* predicted, cv::Mat* mask) {
   WarpImage(mesh, view_i, render_i, view_j, render_j, image_j, options,
-            cv::Rect(0, 0, view_i.width, view_i.height), predicted, mask, nullptr, nullptr);
+            cv::Rect(0, 0, view_i.width, view_i.height), predicted, mask, nullptr, nullptr,
+            nullptr);
 }
 
 DataTermAccumulator::DataTermAccumulator(int num_vertices)
@@ -206,9 +269,10 @@ long DataTermAccumulator::AddPair(const MeshGeometry& mesh, const PinholeView& v
   // Only the pixels around the surface's image are warped and compared.
   const cv::Rect box = ForegroundBox(render_i);
   if (box.empty()) return 0;
-  cv::Mat predicted, mask, derivative, footprint;
+  cv::Mat predicted, mask, derivative, footprint, blur_i;
   WarpImage(mesh, view_i, render_i, view_j, render_j, image_j, options, box, &predicted, &mask,
-            with_gradient ? &derivative : nullptr, with_gradient ? &footprint : nullptr);
+            with_gradient ? &derivative : nullptr, with_gradient ? &footprint : nullptr,
+            options.match_resolution ? &blur_i : nullptr);
   const long valid = cv::countNonZero(mask);
   if (valid == 0) return 0;
   // The similarity's Gaussian pads with zeros and every moment it filters is
@@ -225,6 +289,22 @@ long DataTermAccumulator::AddPair(const MeshGeometry& mesh, const PinholeView& v
 
   // Both images in the precision the similarity computes in.
   cv::Mat observed = image_i(cv::Rect(origin, roi.size()));
+  if (options.match_resolution) {
+    MR_CHECK(image_i.type() == CV_32F) << "image_i must be CV_32F";
+    // Image i blurred where view j sees the surface coarser.
+    observed = observed.clone();
+    blur_i = blur_i(roi);
+    const bool cubic = options.interpolation == "cubic";
+#pragma omp parallel for schedule(static)
+    for (int row = 0; row < roi.height; ++row) {
+      for (int col = 0; col < roi.width; ++col) {
+        const float sigma = blur_i.at<float>(row, col);
+        if (sigma <= 0) continue;
+        observed.at<float>(row, col) = static_cast<float>(SampleBlurred(
+            image_i, origin.x + col + 0.5, origin.y + row + 0.5, sigma, cubic, nullptr));
+      }
+    }
+  }
   if (similarity.double_precision) {
     observed.convertTo(observed, CV_64F);
   } else {

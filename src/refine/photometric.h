@@ -21,11 +21,24 @@
 // The depth d is recomputed in double precision from the face's plane, so the
 // term is exact given the visible face of each pixel.
 //
+// Resolution matching (PairTermOptions::match_resolution). Pixel p of view i
+// integrates the surface over its footprint, which covers s x s pixels of
+// view j, s = sqrt|det ∂q/∂p| through the face's plane. A camera's pixel is
+// a box of variance 1/12 pixel² per axis, so where s > 1 (view j sees the
+// surface finer) image j is sharper than image i by a blur of variance
+// (s² - 1) / 12 of its pixels, and where s < 1 image i is sharper by
+// (1/s² - 1) / 12 of its own. The sharper side is blurred by that much:
+// averaged over the four points at ±σ along each axis around the sampled
+// point (a kernel of variance σ² per axis), each point interpolated. σ is
+// held fixed in the derivative (it changes with the surface's tilt,
+// slowly).
+//
 // Alongside the gradient a Gauss-Newton curvature H_k = Σ_p w_k a² / v₂(p)
 // is accumulated (v₂ the local variance of Î; 1/v₂ is the curvature of
 // 1 - ZNCC with respect to one predicted pixel near a match). The refiner
 // steps by -G_k / H_k, which is invariant to the scale of the scene.
 
+#include <string>
 #include <vector>
 
 #include <opencv2/core.hpp>
@@ -46,6 +59,12 @@ struct PairTermOptions {
   // Pixels seen at |cos(angle between ray and normal)| below this in either
   // view are dropped (grazing surfaces give unreliable warps).
   double min_cos_angle = 0.15;
+  // How image j is sampled at the warped points: "cubic" (Catmull-Rom, see
+  // SampleCubic) or "bilinear".
+  std::string interpolation = "cubic";
+  // Compare each pixel at the coarser of the two views' resolutions on the
+  // surface there (above).
+  bool match_resolution = true;
   bool Check() const;
 };
 
@@ -74,7 +93,8 @@ struct MeshGeometry {
 };
 
 // Builds the predicted image Î_ij in view i (CV_64F, 0 outside the valid
-// domain) and the valid-domain mask (CV_8U, 255 = valid). `image_j` is CV_32F.
+// domain) and the valid-domain mask (CV_8U, 255 = valid). `image_j` is CV_32F,
+// sampled as options.interpolation says, without resolution matching.
 void PredictImage(const MeshGeometry& mesh, const PinholeView& view_i,
                   const RenderBuffers& render_i, const PinholeView& view_j,
                   const RenderBuffers& render_j, const cv::Mat& image_j,

@@ -1123,6 +1123,11 @@ void RegisterRefineOptions(OptionManager* o, RefineOptions* r) {
          "largest vertex motion per iteration, in pixel footprints (> 0)");
   o->Add("Refine.damping", &r->damping, "Levenberg damping relative to the median curvature");
   o->Add("Refine.similarity", &r->similarity, "dcv (detail-preserving) or zncc");
+  o->Add("Refine.interpolation", &r->pair.interpolation,
+         "how the other view's image is sampled at the warped points: cubic or bilinear");
+  o->Add("Refine.match_resolution", &r->pair.match_resolution,
+         "compare each pixel at the coarser of the two views' resolutions on the surface (the "
+         "sharper image blurred by the difference of their pixel footprints)");
   o->Add("Refine.color", &r->color,
          "images compared on: luminance, or principal (colour direction of most texture)");
   o->Add("Refine.kappa", &r->kappa, "final weight of the detail-preserving term (>= 0)");
@@ -1205,7 +1210,11 @@ double PhotoConsistency(const ViewSource& source, const std::vector<int>& eval_v
   MeshGeometry geometry{&V, &F, FaceNormals(V, F)};
   SimilarityOptions zncc;
   zncc.method = "zncc";
+  // The measurement stays the one the figures in docs/ were taken with,
+  // whatever the refiner's pair-term defaults.
   PairTermOptions pair;
+  pair.interpolation = "bilinear";
+  pair.match_resolution = false;
   DataTermAccumulator accumulator(static_cast<int>(V.rows()));
   const std::set<int> evaluated(eval_views.begin(), eval_views.end());
   for (int i : eval_views) {
