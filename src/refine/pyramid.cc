@@ -249,54 +249,48 @@ PinholeView PyramidLevelView(const PinholeView& view, int level) {
   return v;
 }
 
-double SampleBilinear(const cv::Mat& img, double x, double y, Eigen::Vector2d* grad) {
+namespace {
+
+// Checks that `img` is a non-empty single-channel CV_8U, CV_32F or CV_64F
+// image and returns sample(T()) with T its pixel type. `name` is the caller's,
+// for the messages.
+template <typename Sample>
+double ByPixelType(const cv::Mat& img, const char* name, const Sample& sample) {
   MR_CHECK(!img.empty() && img.channels() == 1)
-      << "SampleBilinear: expected a non-empty single-channel image";
+      << name << ": expected a non-empty single-channel image";
   switch (img.depth()) {
     case CV_8U:
-      return SampleTyped<uchar>(img, x, y, grad);
+      return sample(uchar());
     case CV_32F:
-      return SampleTyped<float>(img, x, y, grad);
+      return sample(float());
     case CV_64F:
-      return SampleTyped<double>(img, x, y, grad);
+      return sample(double());
     default:
-      MR_CHECK(false) << "SampleBilinear: image depth must be CV_8U, CV_32F or CV_64F";
+      MR_CHECK(false) << name << ": image depth must be CV_8U, CV_32F or CV_64F";
   }
   return 0;
 }
 
+}  // namespace
+
+double SampleBilinear(const cv::Mat& img, double x, double y, Eigen::Vector2d* grad) {
+  return ByPixelType(img, "SampleBilinear", [&](auto pixel) {
+    return SampleTyped<decltype(pixel)>(img, x, y, grad);
+  });
+}
+
 double SampleCubic(const cv::Mat& img, double x, double y, Eigen::Vector2d* grad) {
-  MR_CHECK(!img.empty() && img.channels() == 1)
-      << "SampleCubic: expected a non-empty single-channel image";
-  switch (img.depth()) {
-    case CV_8U:
-      return SampleCubicTyped<uchar>(img, x, y, grad);
-    case CV_32F:
-      return SampleCubicTyped<float>(img, x, y, grad);
-    case CV_64F:
-      return SampleCubicTyped<double>(img, x, y, grad);
-    default:
-      MR_CHECK(false) << "SampleCubic: image depth must be CV_8U, CV_32F or CV_64F";
-  }
-  return 0;
+  return ByPixelType(img, "SampleCubic", [&](auto pixel) {
+    return SampleCubicTyped<decltype(pixel)>(img, x, y, grad);
+  });
 }
 
 double SampleCubicBlurred(const cv::Mat& img, double x, double y, double sigma,
                           Eigen::Vector2d* grad) {
-  MR_CHECK(!img.empty() && img.channels() == 1)
-      << "SampleCubicBlurred: expected a non-empty single-channel image";
   MR_CHECK(sigma >= 0 && sigma <= 3) << "SampleCubicBlurred: sigma " << sigma << " not in [0, 3]";
-  switch (img.depth()) {
-    case CV_8U:
-      return SampleCubicBlurredTyped<uchar>(img, x, y, sigma, grad);
-    case CV_32F:
-      return SampleCubicBlurredTyped<float>(img, x, y, sigma, grad);
-    case CV_64F:
-      return SampleCubicBlurredTyped<double>(img, x, y, sigma, grad);
-    default:
-      MR_CHECK(false) << "SampleCubicBlurred: image depth must be CV_8U, CV_32F or CV_64F";
-  }
-  return 0;
+  return ByPixelType(img, "SampleCubicBlurred", [&](auto pixel) {
+    return SampleCubicBlurredTyped<decltype(pixel)>(img, x, y, sigma, grad);
+  });
 }
 
 }  // namespace mr

@@ -2,6 +2,7 @@
 
 #include <cmath>
 #include <random>
+#include <utility>
 
 #include <gtest/gtest.h>
 #include <opencv2/imgproc.hpp>
@@ -158,11 +159,17 @@ TEST(SampleBilinear, ExactAtPixelCentres) {
   EXPECT_DOUBLE_EQ(SampleBilinear(u8, 1.0, 1.5), 100.0);
 }
 
-TEST(SampleBilinear, GradientMatchesFiniteDifferences) {
-  cv::Mat img(9, 11, CV_64F);
+// A random image in [0, 1), as CV_64F and as CV_32F.
+std::pair<cv::Mat, cv::Mat> RandomImage(int rows, int cols) {
+  cv::Mat img(rows, cols, CV_64F);
   cv::randu(img, 0.0, 1.0);
   cv::Mat f;
   img.convertTo(f, CV_32F);
+  return {img, f};
+}
+
+TEST(SampleBilinear, GradientMatchesFiniteDifferences) {
+  const auto [img, f] = RandomImage(9, 11);
   std::mt19937 rng(2);
   std::uniform_real_distribution<double> ux(0.5, 10.5), uy(0.5, 8.5);
   const double h = 1e-6;
@@ -244,11 +251,10 @@ TEST(SampleCubic, ExactAtPixelCentresAndOnQuadratics) {
 }
 
 TEST(SampleCubic, GradientMatchesFiniteDifferencesAndIsContinuous) {
-  cv::Mat img(9, 11, CV_64F);
-  cv::randu(img, 0.0, 1.0);
-  cv::Mat f, u8;
-  img.convertTo(f, CV_32F);
-  img.convertTo(u8, CV_8U, 255.0);
+  const auto [img, f] = RandomImage(9, 11);
+  cv::Mat u8_image;
+  img.convertTo(u8_image, CV_8U, 255.0);
+  const cv::Mat& u8 = u8_image;
   std::mt19937 rng(2);
   std::uniform_real_distribution<double> ux(0.5, 10.5), uy(0.5, 8.5);
   const double h = 1e-6;
@@ -317,10 +323,7 @@ TEST(SampleCubic, ImageBorder) {
 }
 
 TEST(SampleCubicBlurred, IsTheMeanOfFourCubicSamples) {
-  cv::Mat img(12, 15, CV_64F);
-  cv::randu(img, 0.0, 1.0);
-  cv::Mat f;
-  img.convertTo(f, CV_32F);
+  const auto [img, f] = RandomImage(12, 15);
   std::mt19937 rng(5);
   // Points across the whole image and beyond its border, where some of the
   // four points are clamped and others not.
