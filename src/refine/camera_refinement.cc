@@ -49,7 +49,9 @@ constexpr double kMinGradient = 1e-3;
 // may be null). Returns false where the warp is undefined (ray parallel to
 // the plane, plane behind camera i, point behind camera j).
 // `delta` (may be null: 0) shifts the face plane: n·X = plane_offset + δ.
-bool EvaluatePhotometric(const PhotometricSample& s, const cv::Mat& image_j, const double* Ri_p,
+// Image j is read by cubic interpolation, or bilinear without `cubic`.
+bool EvaluatePhotometric(const PhotometricSample& s, const cv::Mat& image_j, bool cubic,
+                         const double* Ri_p,
                          const double* Ci_p, const double* Ki, const double* Rj_p,
                          const double* Cj_p, const double* Kj, const double* ab,
                          const double* delta, double* residual, double* J_Ri, double* J_Ci,
@@ -73,7 +75,9 @@ bool EvaluatePhotometric(const PhotometricSample& s, const cv::Mat& image_j, con
   const double iz = 1.0 / Xc.z();
   const double u = Xc.x() * iz, v = Xc.y() * iz;
   Eigen::Vector2d g;
-  const double intensity_j = SampleBilinear(image_j, Kj[0] * u + Kj[2], Kj[1] * v + Kj[3], &g);
+  const double qx = Kj[0] * u + Kj[2], qy = Kj[1] * v + Kj[3];
+  const double intensity_j =
+      cubic ? SampleCubic(image_j, qx, qy, &g) : SampleBilinear(image_j, qx, qy, &g);
   residual[0] = intensity_j - (ab[0] * s.intensity + ab[1]);
 
   if (J_ab != nullptr) {
@@ -134,8 +138,12 @@ bool EvaluatePhotometric(const PhotometricSample& s, const cv::Mat& image_j, con
 class PhotometricCost : public ceres::CostFunction {
  public:
   PhotometricCost(const PhotometricSample& sample, const cv::Mat& image_j, bool shared_intrinsics,
-                  bool free_surface)
-      : sample_(sample), image_j_(image_j), shared_(shared_intrinsics), free_(free_surface) {
+                  bool free_surface, bool cubic)
+      : sample_(sample),
+        image_j_(image_j),
+        shared_(shared_intrinsics),
+        free_(free_surface),
+        cubic_(cubic) {
     set_num_residuals(1);
     std::vector<int32_t>* sizes = mutable_parameter_block_sizes();
     *sizes = shared_ ? std::vector<int32_t>{12, 12, 4, 2} : std::vector<int32_t>{12, 4, 12, 4, 2};
@@ -147,14 +155,16 @@ class PhotometricCost : public ceres::CostFunction {
       return J == nullptr || J[k] == nullptr ? nullptr : J[k] + offset;
     };
     if (!shared_) {
-      return EvaluatePhotometric(sample_, image_j_, p[0], p[0] + 9, p[1], p[2], p[2] + 9, p[3],
+      return EvaluatePhotometric(sample_, image_j_, cubic_, p[0], p[0] + 9, p[1], p[2], p[2] + 9,
+                                 p[3],
                                  p[4], free_ ? p[5] : nullptr, residual, jac(0, 0), jac(0, 9),
                                  jac(1, 0), jac(2, 0), jac(2, 9), jac(3, 0), jac(4, 0),
                                  free_ ? jac(5, 0) : nullptr);
     }
     double J_Ki[4], J_Kj[4];
     const bool want_k = jac(2, 0) != nullptr;
-    if (!EvaluatePhotometric(sample_, image_j_, p[0], p[0] + 9, p[2], p[1], p[1] + 9, p[2], p[3],
+    if (!EvaluatePhotometric(sample_, image_j_, cubic_, p[0], p[0] + 9, p[2], p[1], p[1] + 9, p[2],
+                             p[3],
                              free_ ? p[4] : nullptr, residual, jac(0, 0), jac(0, 9),
                              want_k ? J_Ki : nullptr, jac(1, 0), jac(1, 9),
                              want_k ? J_Kj : nullptr, jac(3, 0), free_ ? jac(4, 0) : nullptr)) {
@@ -171,6 +181,7 @@ class PhotometricCost : public ceres::CostFunction {
   cv::Mat image_j_;
   bool shared_;
   bool free_;
+  bool cubic_;
 };
 
 Eigen::Matrix3d Hat(const Eigen::Vector3d& v) {
@@ -364,9 +375,11 @@ struct CameraSetDatum {
 }  // namespace
 
 ceres::CostFunction* NewPhotometricCost(const PhotometricSample& sample, const cv::Mat& image_j,
-                                        bool shared_intrinsics, bool free_surface) {
+                                        bool shared_intrinsics, bool free_surface,
+                                        bool cubic_interpolation) {
   MR_CHECK_EQ(image_j.type(), CV_32F);
-  return new PhotometricCost(sample, image_j, shared_intrinsics, free_surface);
+  return new PhotometricCost(sample, image_j, shared_intrinsics, free_surface,
+                             cubic_interpolation);
 }
 
 ceres::Manifold* NewRotationMatrixManifold() { return new RotationMatrixManifold(); }
@@ -494,6 +507,10 @@ bool CameraRefinementOptions::Check() const {
   if (mode != "poses" && mode != "poses_intrinsics") {
     MR_THROW_INPUT << "CameraRefinementOptions::mode = " << mode
                    << ". Violated constraint: mode is poses or poses_intrinsics";
+  }
+  if (interpolation != "cubic" && interpolation != "bilinear") {
+    MR_THROW_INPUT << "CameraRefinementOptions::interpolation = " << interpolation
+                   << ". Violated constraint: interpolation is cubic or bilinear";
   }
   if (max_samples_per_pair < 1) {
     MR_THROW_INPUT << "CameraRefinementOptions::max_samples_per_pair = " << max_samples_per_pair
@@ -768,7 +785,9 @@ void BuildProblem(const std::vector<cv::Mat>& gray_images, const std::vector<Ord
                     {p.pose[j].data(), p.intrinsics[bj].data(), p.brightness[k].data()});
       if (free_surface) blocks.push_back(&p.surface_offset[sample.face]);
       problem->AddResidualBlock(
-          internal::NewPhotometricCost(sample, gray_images[j], bi == bj, free_surface), loss,
+          internal::NewPhotometricCost(sample, gray_images[j], bi == bj, free_surface,
+                                       options.interpolation == "cubic"),
+          loss,
           blocks);
     }
     (*refined)[i] = !fixed[i];

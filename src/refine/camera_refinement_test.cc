@@ -249,62 +249,69 @@ TEST_F(CameraRefinementTest, PhotometricJacobianMatchesFiniteDifferences) {
   std::array<double, 2> ab = {1.1, -0.03};
   std::unique_ptr<ceres::Manifold> pose(internal::NewPoseManifold());
 
-  // Error per block at 20 samples spread through the list: each below 1e-6
-  // (measured at most 1e-9, the round-off of the differences). The bilinear
-  // interpolant's gradient jumps at pixel borders, so a probe whose steps
-  // straddle one would differ; at 2e-4 px steps none of these does. Checked
-  // by hand that the test fails when one term is altered: the sign of the
-  // ray term in ∂X/∂C_i gives errors of 0.6 to 1.6, ∂r/∂f_y of view j off
-  // by 0.1 % gives 5e-5, the sign of ∂r/∂δ flipped gives 2.
-  const char* separate_names[] = {"pose_i", "K_i", "pose_j", "K_j", "ab", "δ"};
-  const char* shared_names[] = {"pose_i", "pose_j", "K", "ab", "δ"};
-  std::vector<std::vector<double>> separate(6), shared(5), fixed_surface(1);
-  // The free surface's plane offset, off 0 (in scene units; the footprint is ~0.013).
-  double delta = 0.004;
-  for (int k = 0; k < 20; ++k) {
-    const auto& sample = samples[k * samples.size() / 20];
-    // With a free surface (the δ block last); the blocks they share with the
-    // fixed-surface cost are checked there too.
-    std::unique_ptr<ceres::CostFunction> cost(
-        internal::NewPhotometricCost(sample, s.images[j], false, true));
-    const std::vector<double> e = JacobianErrors(
-        *cost, {pose.get(), nullptr, pose.get(), nullptr, nullptr, nullptr},
-        {pose_i.data(), Ki.data(), pose_j.data(), Kj.data(), ab.data(), &delta});
-    for (int b = 0; b < 6; ++b) separate[b].push_back(e[b]);
-    std::unique_ptr<ceres::CostFunction> shared_cost(
-        internal::NewPhotometricCost(sample, s.images[j], true, true));
-    const std::vector<double> f =
-        JacobianErrors(*shared_cost, {pose.get(), pose.get(), nullptr, nullptr, nullptr},
-                       {pose_i.data(), pose_j.data(), Kj.data(), ab.data(), &delta});
-    for (int b = 0; b < 5; ++b) shared[b].push_back(f[b]);
-    for (bool shared_k : {false, true}) {
-      std::unique_ptr<ceres::CostFunction> fixed(
-          internal::NewPhotometricCost(sample, s.images[j], shared_k, false));
-      std::vector<double*> blocks = {pose_i.data()};
-      if (!shared_k) blocks.push_back(Ki.data());
-      blocks.insert(blocks.end(), {pose_j.data(), Kj.data(), ab.data()});
-      std::vector<const ceres::Manifold*> manifolds(blocks.size(), nullptr);
-      manifolds[0] = manifolds[shared_k ? 1 : 2] = pose.get();
-      for (double error : JacobianErrors(*fixed, manifolds, blocks)) {
-        fixed_surface[0].push_back(error);
+  // Both interpolants of image j (cubic, the default, and bilinear).
+  for (const bool cubic : {true, false}) {
+    // Error per block at 20 samples spread through the list: each below 1e-6
+    // (measured with bilinear sampling at most 1e-9, the round-off of the
+    // differences, the interpolant being linear along each axis within a
+    // pixel; with cubic at most 7.4e-7, the differences' own truncation
+    // error, h^2 f''' / 6 at steps of 2e-4 px). The bilinear interpolant's
+    // gradient jumps at pixel borders, so a probe whose steps straddle one
+    // would differ; at 2e-4 px steps none of these does. Checked by hand
+    // that the test fails when one term is altered: the sign of the
+    // ray term in ∂X/∂C_i gives errors of 0.6 to 1.6, ∂r/∂f_y of view j off
+    // by 0.1 % gives 5e-5, the sign of ∂r/∂δ flipped gives 2.
+    const char* separate_names[] = {"pose_i", "K_i", "pose_j", "K_j", "ab", "δ"};
+    const char* shared_names[] = {"pose_i", "pose_j", "K", "ab", "δ"};
+    std::vector<std::vector<double>> separate(6), shared(5), fixed_surface(1);
+    // The free surface's plane offset, off 0 (in scene units; the footprint is ~0.013).
+    double delta = 0.004;
+    for (int k = 0; k < 20; ++k) {
+      const auto& sample = samples[k * samples.size() / 20];
+      // With a free surface (the δ block last); the blocks they share with the
+      // fixed-surface cost are checked there too.
+      std::unique_ptr<ceres::CostFunction> cost(
+          internal::NewPhotometricCost(sample, s.images[j], false, true, cubic));
+      const std::vector<double> e = JacobianErrors(
+          *cost, {pose.get(), nullptr, pose.get(), nullptr, nullptr, nullptr},
+          {pose_i.data(), Ki.data(), pose_j.data(), Kj.data(), ab.data(), &delta});
+      for (int b = 0; b < 6; ++b) separate[b].push_back(e[b]);
+      std::unique_ptr<ceres::CostFunction> shared_cost(
+          internal::NewPhotometricCost(sample, s.images[j], true, true, cubic));
+      const std::vector<double> f =
+          JacobianErrors(*shared_cost, {pose.get(), pose.get(), nullptr, nullptr, nullptr},
+                         {pose_i.data(), pose_j.data(), Kj.data(), ab.data(), &delta});
+      for (int b = 0; b < 5; ++b) shared[b].push_back(f[b]);
+      for (bool shared_k : {false, true}) {
+        std::unique_ptr<ceres::CostFunction> fixed(
+            internal::NewPhotometricCost(sample, s.images[j], shared_k, false, cubic));
+        std::vector<double*> blocks = {pose_i.data()};
+        if (!shared_k) blocks.push_back(Ki.data());
+        blocks.insert(blocks.end(), {pose_j.data(), Kj.data(), ab.data()});
+        std::vector<const ceres::Manifold*> manifolds(blocks.size(), nullptr);
+        manifolds[0] = manifolds[shared_k ? 1 : 2] = pose.get();
+        for (double error : JacobianErrors(*fixed, manifolds, blocks)) {
+          fixed_surface[0].push_back(error);
+        }
       }
     }
+    const auto report = [cubic](const char* what, const char* const* names,
+                           std::vector<std::vector<double>>* errors) {
+      double worst = 0;
+      for (size_t b = 0; b < errors->size(); ++b) {
+        std::vector<double>& e = (*errors)[b];
+        std::sort(e.begin(), e.end());
+        std::printf("  %s %s %-4s median %.2e, max %.2e\n", cubic ? "cubic" : "bilinear", what, names[b],
+                    e[e.size() / 2], e.back());
+        worst = std::max(worst, e.back());
+      }
+      return worst;
+    };
+    EXPECT_LT(report("separate", separate_names, &separate), 1e-6);
+    EXPECT_LT(report("shared", shared_names, &shared), 1e-6);
+    const char* fixed_names[] = {"all"};
+    EXPECT_LT(report("fixed surface", fixed_names, &fixed_surface), 1e-6);
   }
-  const auto report = [](const char* what, const char* const* names,
-                         std::vector<std::vector<double>>* errors) {
-    double worst = 0;
-    for (size_t b = 0; b < errors->size(); ++b) {
-      std::vector<double>& e = (*errors)[b];
-      std::sort(e.begin(), e.end());
-      std::printf("  %s %-4s median %.2e, max %.2e\n", what, names[b], e[e.size() / 2], e.back());
-      worst = std::max(worst, e.back());
-    }
-    return worst;
-  };
-  EXPECT_LT(report("separate", separate_names, &separate), 1e-6);
-  EXPECT_LT(report("shared", shared_names, &shared), 1e-6);
-  const char* fixed_names[] = {"all"};
-  EXPECT_LT(report("fixed surface", fixed_names, &fixed_surface), 1e-6);
 }
 
 TEST_F(CameraRefinementTest, RotationManifoldPlusMinusAgree) {

@@ -114,6 +114,7 @@ void RefineCamerasAtLevel(const RefineOptions& options,
   for (int i = 0; i < static_cast<int>(views->size()); ++i) gray.push_back(images->Gray(i, level));
   CameraRefinementOptions camera_options = options.camera_refinement;
   camera_options.mode = options.refine_cameras;
+  camera_options.interpolation = options.pair.interpolation;
   const std::vector<PinholeView> prior = LevelViews(input_cameras, level);
   const CameraRefinementSummary refined =
       RefineCameras(gray, pairs, V, F, renderer, camera_of_view, camera_options, views, &prior);
