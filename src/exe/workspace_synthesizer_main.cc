@@ -49,6 +49,9 @@ int main(int argc, char** argv) {
                 "focal length as a multiple of the image width");
     options.Add("fill_fraction", &o.cameras.fill_fraction,
                 "fraction of the image height the object's bounding sphere fills");
+    options.Add("alternate_fill_fraction", &o.cameras.alternate_fill_fraction,
+                "the odd-numbered views at this fill fraction instead: a capture from two "
+                "distances (0: all at fill_fraction)");
     options.Add("supersample", &o.supersample, "supersampling factor per axis (anti-aliasing)");
     options.Add("image_noise", &o.image_noise,
                 "Gaussian image noise per pixel and channel (standard deviation, radiance in "

@@ -63,6 +63,10 @@ bool CameraRigOptions::Check() const {
     MR_THROW_INPUT << "CameraRigOptions::fill_fraction = " << fill_fraction
                    << ". Violated constraint: 0 < fill_fraction <= 1";
   }
+  if (!(alternate_fill_fraction >= 0 && alternate_fill_fraction <= 1)) {
+    MR_THROW_INPUT << "CameraRigOptions::alternate_fill_fraction = " << alternate_fill_fraction
+                   << ". Violated constraint: 0 <= alternate_fill_fraction <= 1";
+  }
   if (!(focal_factor > 0.1 && focal_factor <= 10)) {
     MR_THROW_INPUT << "CameraRigOptions::focal_factor = " << focal_factor
                    << ". Violated constraint: 0.1 < focal_factor <= 10";
@@ -75,11 +79,18 @@ std::vector<PinholeView> MakeCameras(const CameraRigOptions& options, double bou
   MR_CHECK_GT(bounding_radius, 0);
   const double focal = options.focal_factor * options.width;
   // Angular radius alpha of the bounding sphere: focal * tan(alpha) = fill * height / 2.
-  const double alpha = std::atan(options.fill_fraction * 0.5 * options.height / focal);
-  const double distance = bounding_radius / std::sin(alpha);
+  auto distance_filling = [&](double fill) {
+    const double alpha = std::atan(fill * 0.5 * options.height / focal);
+    return bounding_radius / std::sin(alpha);
+  };
+  const double even_distance = distance_filling(options.fill_fraction);
+  const double odd_distance = options.alternate_fill_fraction > 0
+                                  ? distance_filling(options.alternate_fill_fraction)
+                                  : even_distance;
   std::vector<PinholeView> views;
   const int n = options.num_views;
   for (int i = 0; i < n; ++i) {
+    const double distance = i % 2 == 0 ? even_distance : odd_distance;
     double elevation, azimuth;
     if (options.layout == "ring") {
       elevation = options.elevation_deg * kPi / 180;

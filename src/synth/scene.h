@@ -34,6 +34,11 @@ struct CameraRigOptions {
   // Fraction of the image height covered by the object's bounding sphere
   // (about the bounding-box centre; the object itself then fills ~70%). (0, 1].
   double fill_fraction = 0.8;
+  // The odd-numbered views at this fill fraction instead: a capture from two
+  // distances, whose views see the surface at pixel footprints up to
+  // alternate_fill_fraction / fill_fraction apart. 0: every view at
+  // fill_fraction. [0, 1].
+  double alternate_fill_fraction = 0;
   // Focal length in pixels as a multiple of the image width (0.9 ~ 58 deg
   // horizontal field of view). Range (0.1, 10].
   double focal_factor = 0.9;

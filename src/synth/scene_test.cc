@@ -61,6 +61,21 @@ TEST(MakeCameras, RingLooksAtCentreAtElevation) {
   }
 }
 
+TEST(MakeCameras, AlternateFillFractionPutsTheOddViewsAtAnotherDistance) {
+  CameraRigOptions rig;
+  rig.fill_fraction = 0.45;
+  rig.alternate_fill_fraction = 0.9;
+  const std::vector<PinholeView> views = MakeCameras(rig, 40.0);
+  for (size_t i = 0; i < views.size(); ++i) {
+    const double alpha = std::asin(40.0 / views[i].Center().norm());
+    EXPECT_NEAR(std::tan(alpha) * views[i].fy, 0.5 * (i % 2 == 0 ? 0.45 : 0.9) * 480, 1e-6) << i;
+  }
+  // About twice as far: the far views' pixels cover about twice the surface.
+  EXPECT_NEAR(views[0].Center().norm() / views[1].Center().norm(), 2.0, 0.1);
+  rig.alternate_fill_fraction = 1.5;
+  EXPECT_THROW(MakeCameras(rig, 40.0), InputError);
+}
+
 TEST(MakeCameras, HemisphereSpreadsElevations) {
   CameraRigOptions rig;
   rig.layout = "hemisphere";
