@@ -757,6 +757,7 @@ void BuildProblem(const std::vector<cv::Mat>& gray_images, const std::vector<Ord
                   std::vector<char>* refined) {
   CameraParameters& p = *params;
   const bool free_surface = options.surface_sigma_px > 0;
+  const bool cubic = options.interpolation == "cubic";
   if (free_surface) {
     // σ_f from the finest view that samples the face.
     p.surface_offset.assign(num_faces, 0.0);
@@ -785,10 +786,8 @@ void BuildProblem(const std::vector<cv::Mat>& gray_images, const std::vector<Ord
                     {p.pose[j].data(), p.intrinsics[bj].data(), p.brightness[k].data()});
       if (free_surface) blocks.push_back(&p.surface_offset[sample.face]);
       problem->AddResidualBlock(
-          internal::NewPhotometricCost(sample, gray_images[j], bi == bj, free_surface,
-                                       options.interpolation == "cubic"),
-          loss,
-          blocks);
+          internal::NewPhotometricCost(sample, gray_images[j], bi == bj, free_surface, cubic),
+          loss, blocks);
     }
     (*refined)[i] = !fixed[i];
     (*refined)[j] = !fixed[j];

@@ -91,7 +91,6 @@ double SampleTyped(const cv::Mat& img, double x, double y, Eigen::Vector2d* grad
   return top + fv * (bottom - top);
 }
 
-
 // Catmull-Rom weights of the taps at offsets -1, 0, 1, 2 from the cell's
 // first pixel, for the fraction t in [0, 1], and their derivatives in t.
 void CubicWeights(double t, double w[4], double dw[4]) {
@@ -139,9 +138,9 @@ double SampleCubicTyped(const cv::Mat& img, double x, double y, Eigen::Vector2d*
 }
 
 // The taps along one axis of `size` pixels of the mean of the cubic
-// interpolants at x - sigma and x + sigma (x alone for sigma 0): weights of
-// the pixels first .. first + count - 1 (replicated beyond the border) and
-// their derivatives in x (0 for a point clamped to the border).
+// interpolants at x - sigma and x + sigma (sigma > 0): weights of the pixels
+// first .. first + count - 1 (replicated beyond the border) and their
+// derivatives in x (0 for a point clamped to the border).
 struct AxisTaps {
   static constexpr int kMax = 12;
   int first = 0;
@@ -151,27 +150,26 @@ struct AxisTaps {
 };
 
 AxisTaps BlurredCubicTaps(double x, int size, double sigma, bool with_derivative) {
-  const int points = sigma > 0 ? 2 : 1;
   const double positions[2] = {x - sigma, x + sigma};
   int c0[2];
   double fraction[2];
   bool clamped[2];
-  for (int p = 0; p < points; ++p) {
-    const double u = IndexCoordinate(points == 1 ? x : positions[p], size, &clamped[p]);
+  for (int p = 0; p < 2; ++p) {
+    const double u = IndexCoordinate(positions[p], size, &clamped[p]);
     c0[p] = std::min(static_cast<int>(u), size - 1);
     fraction[p] = u - c0[p];
   }
   AxisTaps taps;
   taps.first = c0[0] - 1;
-  taps.count = c0[points - 1] + 3 - taps.first;
+  taps.count = c0[1] + 3 - taps.first;
   MR_CHECK_LE(taps.count, AxisTaps::kMax) << "SampleCubicBlurred: sigma too large";
-  for (int p = 0; p < points; ++p) {
+  for (int p = 0; p < 2; ++p) {
     double w[4], dw[4];
     CubicWeights(fraction[p], w, dw);
     const int offset = c0[p] - 1 - taps.first;
-    for (int k = 0; k < 4; ++k) taps.w[offset + k] += w[k] / points;
+    for (int k = 0; k < 4; ++k) taps.w[offset + k] += 0.5 * w[k];
     if (with_derivative && !clamped[p]) {
-      for (int k = 0; k < 4; ++k) taps.dw[offset + k] += dw[k] / points;
+      for (int k = 0; k < 4; ++k) taps.dw[offset + k] += 0.5 * dw[k];
     }
   }
   return taps;
