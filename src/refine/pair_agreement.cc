@@ -80,19 +80,11 @@ PairReport Measure(const cv::Mat& image_i, const cv::Mat& predicted, const cv::M
   // Sobel / 8: the central difference smoothed across, in grey levels per px.
   cv::Sobel(observed, gx, CV_64F, 1, 0, 3, 1.0 / 8);
   cv::Sobel(observed, gy, CV_64F, 0, 1, 3, 1.0 / 8);
-  double sum = 0, sum2 = 0;
-  for (int r = 0; r < interior.rows; ++r) {
-    for (int c = 0; c < interior.cols; ++c) {
-      if (!interior.at<uint8_t>(r, c)) continue;
-      const double d = difference.at<double>(r, c);
-      sum += d;
-      sum2 += d * d;
-      ++report.pixels;
-    }
-  }
+  report.pixels = cv::countNonZero(interior);
   if (report.pixels > 1) {
-    const double mean = sum / report.pixels;
-    report.difference_std = std::sqrt(std::max(0.0, sum2 / report.pixels - mean * mean));
+    cv::Scalar mean, deviation;
+    cv::meanStdDev(difference, mean, deviation, interior);
+    report.difference_std = deviation[0];
   }
   std::vector<double> displacements;
   for (int y = 0; y + kBlock <= interior.rows; y += kBlock) {
@@ -118,12 +110,12 @@ PairReport Measure(const cv::Mat& image_i, const cv::Mat& predicted, const cv::M
   report.blocks = static_cast<int>(displacements.size());
   report.displacement_median = Percentile(displacements, 0.5);
   report.displacement_p90 = Percentile(displacements, 0.9);
-  cv::Mat observed32;
-  image_i.convertTo(observed32, CV_64F);
-  cv::Mat predicted64;
-  predicted.convertTo(predicted64, CV_64F);
-  report.zncc = MeanZncc(observed32, predicted64, interior, sigma, epsilon);
-  report.zncc_tight = MeanZncc(observed32, predicted64, interior, sigma, 1e-6);
+  // The ZNCC on the images' own [0, 1] scale, which epsilon refers to.
+  cv::Mat observed_unit, predicted_unit;
+  image_i.convertTo(observed_unit, CV_64F);
+  predicted.convertTo(predicted_unit, CV_64F);
+  report.zncc = MeanZncc(observed_unit, predicted_unit, interior, sigma, epsilon);
+  report.zncc_tight = MeanZncc(observed_unit, predicted_unit, interior, sigma, 1e-6);
   return report;
 }
 
