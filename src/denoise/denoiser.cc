@@ -12,6 +12,7 @@
 #include "util/error.h"
 #include "util/logging.h"
 #include "util/options.h"
+#include "util/statistics.h"
 
 namespace mr {
 namespace {
@@ -40,8 +41,7 @@ double RobustSigma(const Eigen::MatrixXd& R, const Eigen::MatrixXd& W) {
     if (wn > 0) r.push_back(R.row(i).norm() / wn);
   }
   if (r.empty()) return 0;
-  std::nth_element(r.begin(), r.begin() + r.size() / 2, r.end());
-  return r[r.size() / 2] / 0.6745;
+  return Median(&r) / 0.6745;
 }
 
 void DenoiseLp(const Eigen::MatrixXd& V0, const Eigen::MatrixXi& F, const DenoiseOptions& o,

@@ -17,6 +17,7 @@
 #include "render/renderer.h"
 #include "util/error.h"
 #include "util/logging.h"
+#include "util/statistics.h"
 
 namespace mr {
 namespace {
@@ -282,10 +283,11 @@ EvaluationResult EvaluateMesh(const Eigen::MatrixXd& V, const Eigen::MatrixXi& F
   result.mean_accuracy = Mean(to_gt.distance);
   result.chamfer = result.mean_accuracy + Mean(to_recon.distance);
 
-  std::vector<double> sorted = to_gt.distance;
-  const size_t k = static_cast<size_t>(std::ceil(0.9 * sorted.size())) - 1;  // nearest rank
-  std::nth_element(sorted.begin(), sorted.begin() + k, sorted.end());
-  result.accuracy90 = sorted[k];
+  // The nearest-rank 90th percentile, rank ceil(0.9 n) - 1, which is not
+  // Quantile's floor(0.9 n) (one higher whenever 0.9 n is whole).
+  std::vector<double> distances = to_gt.distance;
+  const size_t k = static_cast<size_t>(std::ceil(0.9 * distances.size())) - 1;
+  result.accuracy90 = NthSmallest(&distances, k);
 
   size_t within = 0;
   for (double d : to_recon.distance) within += d <= options.threshold ? 1 : 0;

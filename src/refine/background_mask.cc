@@ -12,6 +12,7 @@
 #include "util/logging.h"
 #include "util/components.h"
 #include "util/mask_distance.h"
+#include "util/statistics.h"
 
 namespace mr {
 
@@ -65,13 +66,6 @@ cv::Mat Smoothed(const cv::Mat& image) {
 // Largest channel difference between a pixel and a colour.
 inline double ColorDistance(const cv::Vec3b& p, const cv::Vec3d& c) {
   return std::max({std::abs(p[0] - c[0]), std::abs(p[1] - c[1]), std::abs(p[2] - c[2])});
-}
-
-double Median(std::vector<double>* values) {
-  MR_CHECK(!values->empty());
-  const size_t mid = values->size() / 2;
-  std::nth_element(values->begin(), values->begin() + mid, values->end());
-  return (*values)[mid];
 }
 
 // The pixels of the border band of width `band`.

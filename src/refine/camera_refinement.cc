@@ -20,6 +20,7 @@
 #include "render/renderer.h"
 #include "util/error.h"
 #include "util/logging.h"
+#include "util/statistics.h"
 
 namespace mr {
 namespace internal {
@@ -563,8 +564,7 @@ double MedianFootprint(const PinholeView& view, const RenderBuffers& render) {
     if (render.face_id[k] >= 0) depths.push_back(render.depth[k]);
   }
   if (depths.empty()) return 0;
-  std::nth_element(depths.begin(), depths.begin() + depths.size() / 2, depths.end());
-  return depths[depths.size() / 2] / view.fx;
+  return Median(&depths) / view.fx;
 }
 
 // Which of `num_views` views take part in a pair (pairs naming a view out of
@@ -1003,9 +1003,7 @@ CameraRefinementSummary RefineCameras(const std::vector<cv::Mat>& gray_images,
   summary.num_faces = static_cast<int>(offsets_px.size());
   if (!offsets_px.empty()) {
     summary.max_surface_offset_px = MaxOf(offsets_px);
-    std::nth_element(offsets_px.begin(), offsets_px.begin() + offsets_px.size() / 2,
-                     offsets_px.end());
-    summary.median_surface_offset_px = offsets_px[offsets_px.size() / 2];
+    summary.median_surface_offset_px = Median(&offsets_px);
   }
   summary.seconds = ElapsedSeconds() - start_s;
 

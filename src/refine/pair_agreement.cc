@@ -35,17 +35,11 @@
 #include "util/error.h"
 #include "util/options.h"
 #include "util/program.h"
+#include "util/statistics.h"
 
 namespace {
 
 using namespace mr;
-
-double Percentile(std::vector<double> values, double q) {
-  if (values.empty()) return 0;
-  const size_t k = std::min(values.size() - 1, static_cast<size_t>(q * values.size()));
-  std::nth_element(values.begin(), values.begin() + k, values.end());
-  return values[k];
-}
 
 double MeanZncc(const cv::Mat& observed, const cv::Mat& predicted, const cv::Mat& mask,
                 double sigma, double epsilon) {
@@ -108,8 +102,11 @@ PairReport Measure(const cv::Mat& image_i, const cv::Mat& predicted, const cv::M
     }
   }
   report.blocks = static_cast<int>(displacements.size());
-  report.displacement_median = Percentile(displacements, 0.5);
-  report.displacement_p90 = Percentile(displacements, 0.9);
+  // Quantile reorders `displacements`, which cannot change the second result:
+  // they are finite and non-negative (hypot never gives -0), so values that
+  // compare equal are bitwise equal.
+  report.displacement_median = displacements.empty() ? 0 : Quantile(&displacements, 0.5);
+  report.displacement_p90 = displacements.empty() ? 0 : Quantile(&displacements, 0.9);
   // The ZNCC on the images' own [0, 1] scale, which epsilon refers to.
   cv::Mat observed_unit, predicted_unit;
   image_i.convertTo(observed_unit, CV_64F);

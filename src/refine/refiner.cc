@@ -24,6 +24,7 @@
 #include "util/error.h"
 #include "util/logging.h"
 #include "util/options.h"
+#include "util/statistics.h"
 
 namespace mr {
 namespace {
@@ -239,21 +240,13 @@ class BackgroundRemesh {
   std::future<bool> result_;
 };
 
-// Upper median of `values` (which must not be empty); reorders them.
-template <typename T>
-T Median(std::vector<T>& values) {
-  MR_CHECK(!values.empty());
-  std::nth_element(values.begin(), values.begin() + values.size() / 2, values.end());
-  return values[values.size() / 2];
-}
-
 // Median of the positive entries, or 0.
 double MedianPositive(const Eigen::VectorXd& x) {
   std::vector<double> values;
   for (int i = 0; i < x.size(); ++i) {
     if (x(i) > 0) values.push_back(x(i));
   }
-  return values.empty() ? 0.0 : Median(values);
+  return values.empty() ? 0.0 : Median(&values);
 }
 
 }  // namespace
@@ -458,7 +451,7 @@ double MeasureMisalignmentPx(const std::vector<PinholeView>& views,
         if (erode.at<uint8_t>(r, c)) gradients.push_back(gradient.at<float>(r, c));
       }
     }
-    const float gradient_median = Median(gradients);
+    const float gradient_median = Median(&gradients);
     std::vector<float> shifts;
     for (int r = 0; r < erode.rows; ++r) {
       for (int c = 0; c < erode.cols; ++c) {
@@ -468,9 +461,9 @@ double MeasureMisalignmentPx(const std::vector<PinholeView>& views,
       }
     }
     if (shifts.empty()) continue;
-    per_pair.push_back(Median(shifts));
+    per_pair.push_back(Median(&shifts));
   }
-  return per_pair.empty() ? 0.0 : Median(per_pair);
+  return per_pair.empty() ? 0.0 : Median(&per_pair);
 }
 
 // Picks the number of pyramid levels from the input itself: its misalignment

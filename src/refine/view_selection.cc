@@ -9,6 +9,7 @@
 
 #include "geometry/mesh.h"
 #include "util/error.h"
+#include "util/statistics.h"
 
 namespace mr {
 
@@ -107,12 +108,8 @@ void AppendFootprints(const std::vector<PinholeView>& views, const Eigen::Vector
   }
 }
 
-// The element at size / 2 of the sorted values (reorders them); 0 if none.
-double UpperMedian(std::vector<double>* values) {
-  if (values->empty()) return 0;
-  std::nth_element(values->begin(), values->begin() + values->size() / 2, values->end());
-  return (*values)[values->size() / 2];
-}
+// The upper median of the values (reorders them); 0 if none.
+double UpperMedian(std::vector<double>* values) { return values->empty() ? 0 : Median(values); }
 
 }  // namespace
 

@@ -15,6 +15,7 @@
 #include "colmap_io/camera_models.h"
 #include "util/error.h"
 #include "util/logging.h"
+#include "util/statistics.h"
 
 namespace mr {
 namespace {
@@ -63,13 +64,6 @@ double DisplacementRms(const PinholeView& view, const VisiblePoints& visible,
     sum += (view.CameraToImage(Xc) - visible.image[k]).squaredNorm();
   }
   return std::sqrt(sum / visible.camera.size());
-}
-
-double Median(std::vector<double> values) {
-  MR_CHECK(!values.empty());
-  const size_t mid = values.size() / 2;
-  std::nth_element(values.begin(), values.begin() + mid, values.end());
-  return values[mid];
 }
 
 // The scale s >= 0 of the motion direction (w, shift_camera) whose RMS
@@ -189,7 +183,7 @@ CameraErrorSummary PerturbCameras(const CameraErrorOptions& options,
       std::vector<double> depths;
       depths.reserve(visible.camera.size());
       for (const Eigen::Vector3d& Xc : visible.camera) depths.push_back(Xc.z());
-      const Eigen::Vector3d shift_world = u * Median(depths);
+      const Eigen::Vector3d shift_world = u * Median(&depths);
       const double s = SolveScale(view, visible, w, view.R * shift_world,
                                   options.pose_error_px, &record.rms_px);
       const Eigen::Matrix3d R = ExpRotation(s * w) * view.R;

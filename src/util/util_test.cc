@@ -4,13 +4,18 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
+#include <limits>
+#include <random>
+#include <vector>
 
 #include "util/error.h"
 #include "util/file.h"
 #include "util/interrupt.h"
+#include "util/statistics.h"
 #include "util/testing.h"
 #include "util/options.h"
 
@@ -266,6 +271,72 @@ TEST(OptionManager, BadInput) {
   options2.AddRequired("s", &s, "s");
   const char* missing[] = {"prog"};
   EXPECT_THROW(options2.Parse(1, const_cast<char**>(missing)), InputError);
+}
+
+TEST(Statistics, MedianIsTheUpperMedian) {
+  std::vector<double> odd = {5, 1, 4, 2, 3};
+  EXPECT_EQ(Median(&odd), 3);
+  std::vector<double> even = {4, 1, 3, 2};
+  EXPECT_EQ(Median(&even), 3);  // rank n / 2: the larger middle element, not 2.5
+  std::vector<float> single = {7};
+  EXPECT_EQ(Median(&single), 7);
+  std::vector<int> two = {9, 8};
+  EXPECT_EQ(Median(&two), 9);
+  std::vector<double> empty;
+  EXPECT_THROW(Median(&empty), InternalError);
+}
+
+TEST(Statistics, QuantileRanksAndClamping) {
+  // Rank floor(q n), clamped to n - 1.
+  EXPECT_EQ(QuantileRank(5, 0.0), 0u);
+  EXPECT_EQ(QuantileRank(5, 0.5), 2u);
+  EXPECT_EQ(QuantileRank(5, 0.9), 4u);
+  EXPECT_EQ(QuantileRank(5, 1.0), 4u);  // clamped from 5
+  EXPECT_EQ(QuantileRank(4, 0.5), 2u);
+  EXPECT_EQ(QuantileRank(4, 0.9), 3u);
+  EXPECT_EQ(QuantileRank(4, 1.0), 3u);   // clamped from 4
+  EXPECT_EQ(QuantileRank(10, 0.9), 9u);  // not the nearest rank ceil(0.9 n) - 1 = 8
+  EXPECT_EQ(QuantileRank(1, 0.0), 0u);
+  EXPECT_EQ(QuantileRank(1, 1.0), 0u);
+  EXPECT_THROW(QuantileRank(0, 0.5), InternalError);
+  EXPECT_THROW(QuantileRank(5, -0.1), InternalError);
+  EXPECT_THROW(QuantileRank(5, 1.1), InternalError);
+  EXPECT_THROW(QuantileRank(5, std::numeric_limits<double>::quiet_NaN()), InternalError);
+
+  const std::vector<double> odd = {30, 10, 50, 20, 40};
+  const std::vector<double> even = {3, 1, 4, 2};
+  const auto quantile = [](std::vector<double> values, double q) { return Quantile(&values, q); };
+  EXPECT_EQ(quantile(odd, 0.0), 10);
+  EXPECT_EQ(quantile(odd, 0.5), 30);
+  EXPECT_EQ(quantile(odd, 0.9), 50);
+  EXPECT_EQ(quantile(odd, 1.0), 50);
+  EXPECT_EQ(quantile(even, 0.0), 1);
+  EXPECT_EQ(quantile(even, 0.5), 3);
+  EXPECT_EQ(quantile(even, 0.9), 4);
+  EXPECT_EQ(quantile(even, 1.0), 4);
+  EXPECT_THROW(quantile({}, 0.5), InternalError);
+}
+
+TEST(Statistics, AgreesWithSorting) {
+  std::mt19937 rng(7);
+  for (int n = 1; n <= 40; ++n) {
+    std::vector<int> values(n);
+    for (int& v : values) v = static_cast<int>(rng() % 10);  // with ties
+    std::vector<int> sorted = values;
+    std::sort(sorted.begin(), sorted.end());
+    for (int k = 0; k < n; ++k) {
+      std::vector<int> copy = values;
+      EXPECT_EQ(NthSmallest(&copy, k), sorted[k]) << "n " << n << " k " << k;
+    }
+    std::vector<int> copy = values;
+    EXPECT_EQ(Median(&copy), sorted[n / 2]);
+    for (double q : {0.0, 0.25, 0.5, 0.9, 1.0}) {
+      copy = values;
+      EXPECT_EQ(Quantile(&copy, q), sorted[QuantileRank(n, q)]);
+    }
+    copy = values;
+    EXPECT_THROW(NthSmallest(&copy, n), InternalError);
+  }
 }
 
 }  // namespace
