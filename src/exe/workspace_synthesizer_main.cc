@@ -80,6 +80,12 @@ int main(int argc, char** argv) {
     options.Add("light", &o.appearance.light,
                 "light: world (fixed world direction) or headlight (at the camera)");
     options.Add("ambient", &o.appearance.ambient, "ambient share of the lighting, [0, 1]");
+    options.Add("specular", &o.appearance.specular,
+                "strength of a white Blinn-Phong highlight (glossy surfaces), [0, 1]; 0 = none");
+    options.Add("shininess", &o.appearance.shininess,
+                "Blinn-Phong exponent of the highlight (larger: sharper), [1, 10000]");
+    options.Add("exposure_jitter", &o.exposure_jitter,
+                "standard deviation of the log of a random per-view exposure gain, [0, 1]");
     options.Add("Shape.edge_length", &o.builtin.edge_length,
                 "built-in shape: target edge length (scene units)");
     options.Add("Shape.relief_amplitude", &o.builtin.relief_amplitude,

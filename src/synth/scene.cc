@@ -190,6 +190,20 @@ void AddImageNoise(double sigma, uint32_t seed, uint32_t view_index, SynthImage*
   }
 }
 
+double ApplyExposureJitter(double sigma, uint32_t seed, uint32_t view_index, SynthImage* image) {
+  MR_CHECK(image != nullptr);
+  MR_CHECK(sigma >= 0 && sigma <= 1) << "exposure jitter sigma " << sigma;
+  if (sigma == 0) return 1.0;
+  // A seed sequence of its own, independent of the image and depth noise.
+  std::seed_seq sequence{seed, view_index, 0x65787031u};
+  std::mt19937 rng(sequence);
+  const double gain = std::exp(std::normal_distribution<double>(0.0, sigma)(rng));
+  for (float& value : image->radiance) {
+    value = static_cast<float>(std::min(1.0, value * gain));
+  }
+  return gain;
+}
+
 bool DepthNoiseOptions::Check() const {
   if (!(depth_noise >= 0 && depth_noise <= 0.1)) {
     MR_THROW_INPUT << "DepthNoiseOptions::depth_noise = " << depth_noise

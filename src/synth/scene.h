@@ -92,6 +92,11 @@ SynthImage RenderImage(Renderer& renderer, const SynthScene& scene, const Pinhol
 // [0, 1]. The noise depends only on (seed, view_index). sigma in [0, 0.5].
 void AddImageNoise(double sigma, uint32_t seed, uint32_t view_index, SynthImage* image);
 
+// Multiplies every channel of every pixel by the view's exposure gain
+// exp(N(0, sigma)) and clips at 1; returns the gain. The gain depends only on
+// (seed, view_index). sigma in [0, 1]; 0 leaves the image as it is (gain 1).
+double ApplyExposureJitter(double sigma, uint32_t seed, uint32_t view_index, SynthImage* image);
+
 struct DepthNoiseOptions {
   // Standard deviation of the per-pixel Gaussian depth noise, relative to
   // the depth. Range [0, 0.1].

@@ -265,6 +265,37 @@ TEST(AddImageNoise, HasRequestedLevelAndIsDeterministic) {
   EXPECT_EQ(zero.radiance, clean.radiance);
 }
 
+// One gain per view, log-normal with the requested spread, reproducible from
+// (seed, view index), applied to every channel and clipped at 1.
+TEST(ApplyExposureJitter, ScalesEachViewByItsOwnGain) {
+  SynthImage image;
+  image.width = 4;
+  image.height = 1;
+  image.coverage.assign(4, 1.f);
+  image.radiance = {0.1f, 0.2f, 0.3f, 0.4f, 0.5f, 0.6f, 0.05f, 0.15f, 0.25f, 0.35f, 0.45f, 0.9f};
+  SynthImage a = image, b = image, zero = image;
+  const double gain = ApplyExposureJitter(0.2, 3, 7, &a);
+  EXPECT_EQ(ApplyExposureJitter(0.2, 3, 7, &b), gain);
+  EXPECT_EQ(a.radiance, b.radiance);
+  EXPECT_EQ(ApplyExposureJitter(0, 3, 7, &zero), 1.0);
+  EXPECT_EQ(zero.radiance, image.radiance);
+  for (size_t i = 0; i < image.radiance.size(); ++i) {
+    EXPECT_FLOAT_EQ(a.radiance[i], std::min(1.0, image.radiance[i] * gain)) << i;
+  }
+  // The log-gains of many views have the requested spread and no bias.
+  double sum = 0, sum2 = 0;
+  const int n = 4000;
+  for (int view = 0; view < n; ++view) {
+    SynthImage copy = image;
+    const double log_gain = std::log(ApplyExposureJitter(0.2, 3, view, &copy));
+    sum += log_gain;
+    sum2 += log_gain * log_gain;
+  }
+  const double mean = sum / n, sd = std::sqrt(sum2 / n - mean * mean);
+  EXPECT_NEAR(sd, 0.2, 0.01);
+  EXPECT_NEAR(mean, 0, 0.015);
+}
+
 TEST(RenderDenseMaps, DepthPixelsBackProjectOntoSurfaceWithDenseConvention) {
   const SynthScene scene = CoarseScene();
   const std::vector<PinholeView> views = SmallRing(scene);

@@ -313,5 +313,42 @@ TEST(Texture, HeadlightShinesFromTheCamera) {
   EXPECT_GT(differs_from_world, 0.5 * (P.rows() / 7));
 }
 
+// The highlight: white, at its strongest on the mirror direction (n halfway
+// between the light and the eye), falling off away from it, absent where the
+// light does not reach, and clipped at 1.
+TEST(Texture, SpecularHighlightFollowsTheMirrorDirection) {
+  AppearanceOptions options;
+  options.specular = 0.3;
+  options.shininess = 20;
+  AppearanceOptions matte = options;
+  matte.specular = 0;
+  const Eigen::Vector3d p(1, 2, 3), eye(50, -70, 40);
+  const Eigen::Vector3d l = options.light_direction.normalized();
+  const Eigen::Vector3d half = (l + (eye - p).normalized()).normalized();
+  const Eigen::Vector3d mirror = ShadePoint(options, p, half, eye) - ShadePoint(matte, p, half, eye);
+  for (int c = 0; c < 3; ++c) EXPECT_NEAR(mirror(c), 0.3, 1e-12);  // white, n.h = 1
+  // 20 degrees off the mirror direction, towards the light: 0.3 cos(20)^20.
+  const Eigen::Vector3d side = (l - l.dot(half) * half).normalized();
+  const double angle = 20 * M_PI / 180;
+  const Eigen::Vector3d off = std::cos(angle) * half + std::sin(angle) * side;
+  const Eigen::Vector3d weaker = ShadePoint(options, p, off, eye) - ShadePoint(matte, p, off, eye);
+  EXPECT_NEAR(weaker(0), 0.3 * std::pow(std::cos(angle), 20), 1e-12);
+  // Facing away from the light: no highlight.
+  EXPECT_EQ(ShadePoint(options, p, -l, eye), ShadePoint(matte, p, -l, eye));
+  // Clipped at 1.
+  options.specular = 1;
+  EXPECT_EQ(ShadePoint(options, p, half, eye), Eigen::Vector3d::Ones());
+  for (const double bad : {-0.1, 1.5, std::nan("")}) {
+    AppearanceOptions o;
+    o.specular = bad;
+    EXPECT_THROW(o.Check(), InputError) << bad;
+  }
+  for (const double bad : {0.5, 2e4, std::nan("")}) {
+    AppearanceOptions o;
+    o.shininess = bad;
+    EXPECT_THROW(o.Check(), InputError) << bad;
+  }
+}
+
 }  // namespace
 }  // namespace mr

@@ -96,6 +96,10 @@ bool SynthesizerOptions::Check() const {
     MR_THROW_INPUT << "SynthesizerOptions::supersample = " << supersample
                    << ". Violated constraint: 1 <= supersample <= 8";
   }
+  if (!(exposure_jitter >= 0 && exposure_jitter <= 1)) {
+    MR_THROW_INPUT << "SynthesizerOptions::exposure_jitter = " << exposure_jitter
+                   << ". Violated constraint: 0 <= exposure_jitter <= 1";
+  }
   if (!(image_noise >= 0 && image_noise <= 0.5)) {
     MR_THROW_INPUT << "SynthesizerOptions::image_noise = " << image_noise
                    << ". Violated constraint: 0 <= image_noise <= 0.5";
@@ -220,6 +224,8 @@ SynthesizerSummary SynthesizeWorkspace(const SynthesizerOptions& options) {
     const std::string name = SynthViewName(static_cast<int>(i));
     names.push_back(name);
     SynthImage image = RenderImage(renderer, scene, views[i], options.supersample);
+    ApplyExposureJitter(options.exposure_jitter, static_cast<uint32_t>(options.seed),
+                        static_cast<uint32_t>(i), &image);
     AddImageNoise(options.image_noise, static_cast<uint32_t>(options.seed),
                   static_cast<uint32_t>(i), &image);
     WriteSynthImagePng(JoinPaths(images_dir, name), image);
@@ -251,7 +257,9 @@ SynthesizerSummary SynthesizeWorkspace(const SynthesizerOptions& options) {
   MR_LOG(INFO) << "Rendered " << views.size() << " views (" << options.cameras.width << "x"
                << options.cameras.height << ", supersample " << options.supersample
                << ", texture " << options.appearance.texture_style << ", light "
-               << options.appearance.light << ", image noise " << options.image_noise
+               << options.appearance.light << ", specular " << options.appearance.specular
+               << ", exposure jitter " << options.exposure_jitter << ", image noise "
+               << options.image_noise
                << ") with depth and normal maps in " << summary.render_seconds << " s";
 
   // Sparse model.

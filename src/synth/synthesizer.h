@@ -52,6 +52,11 @@ struct SynthesizerOptions {
   // channel of the images (radiance in [0, 1], before 8-bit quantisation),
   // seeded by `seed` and the view index; 0 = none. Range [0, 0.5].
   double image_noise = 0;
+  // Standard deviation of the log of a per-view exposure gain: each view's
+  // radiance is multiplied by exp(N(0, exposure_jitter)) (seeded by `seed`
+  // and the view index) and clipped at 1, before the noise, as auto-exposure
+  // varies between photos. 0 = every view exposed alike. Range [0, 1].
+  double exposure_jitter = 0;
   // Write COLMAP masks (dense/masks/<image name>.png).
   bool write_masks = true;
   // Maximum number of sparse points3D (each seen in >= 2 views). [0, 1e7].

@@ -100,6 +100,10 @@ TEST(SynthesizerOptions, RejectsBadImageStyleAndCameraValues) {
   expect_message(rejects([](SynthesizerOptions* o) { o->appearance.texture_contrast = 0; }),
                  "texture_contrast");
   expect_message(rejects([](SynthesizerOptions* o) { o->appearance.ambient = 1.2; }), "ambient");
+  expect_message(rejects([](SynthesizerOptions* o) { o->appearance.specular = -0.1; }),
+                 "specular");
+  expect_message(rejects([](SynthesizerOptions* o) { o->exposure_jitter = 1.5; }),
+                 "exposure_jitter");
   expect_message(rejects([](SynthesizerOptions* o) { o->cameras.focal_factor = 0.05; }),
                  "focal_factor");
   expect_message(rejects([](SynthesizerOptions* o) { o->cameras.focal_factor = 11; }),

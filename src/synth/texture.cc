@@ -134,6 +134,14 @@ bool AppearanceOptions::Check() const {
     MR_THROW_INPUT << "AppearanceOptions::light = " << light
                    << ". Violated constraint: light is world or headlight";
   }
+  if (!(specular >= 0 && specular <= 1)) {
+    MR_THROW_INPUT << "AppearanceOptions::specular = " << specular
+                   << ". Violated constraint: 0 <= specular <= 1";
+  }
+  if (!(shininess >= 1 && shininess <= 10000)) {
+    MR_THROW_INPUT << "AppearanceOptions::shininess = " << shininess
+                   << ". Violated constraint: 1 <= shininess <= 10000";
+  }
   if (!(light_direction.norm() > 0) || !light_direction.allFinite()) {
     MR_THROW_INPUT << "AppearanceOptions::light_direction = (" << light_direction.transpose()
                    << "). Violated constraint: non-zero and finite";
@@ -172,7 +180,12 @@ Eigen::Vector3d ShadePoint(const AppearanceOptions& options, const Eigen::Vector
                                     ? (eye - p).normalized()
                                     : options.light_direction.normalized();
   const double lambert = std::max(0.0, n.dot(light));
-  return Albedo(options, p) * (options.ambient + (1 - options.ambient) * lambert);
+  const Eigen::Vector3d diffuse =
+      Albedo(options, p) * (options.ambient + (1 - options.ambient) * lambert);
+  if (options.specular == 0 || lambert == 0) return diffuse;
+  const Eigen::Vector3d half = (light + (eye - p).normalized()).normalized();
+  const double highlight = options.specular * std::pow(std::max(0.0, n.dot(half)), options.shininess);
+  return (diffuse + Eigen::Vector3d::Constant(highlight)).cwiseMin(1.0);
 }
 
 }  // namespace mr

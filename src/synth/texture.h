@@ -40,6 +40,16 @@ struct AppearanceOptions {
   std::string light = "world";
   // World direction towards the light (normalised internally; non-zero).
   Eigen::Vector3d light_direction = Eigen::Vector3d(0.4, -0.3, 1.0);
+  // Strength of a white Blinn-Phong highlight, specular * (n.h)^shininess
+  // (h halfway between the directions to the light and to the eye), added to
+  // the diffuse colour and clipped at 1 like an over-exposed pixel. The
+  // highlight moves with the viewpoint, so the views disagree where it is:
+  // what glossy real objects do to a photo-consistency measure. Range [0, 1];
+  // 0 = Lambertian only.
+  double specular = 0;
+  // Blinn-Phong exponent of the highlight (larger: smaller, sharper). Range
+  // [1, 10000].
+  double shininess = 40;
 
   bool Check() const;
 };
@@ -55,10 +65,13 @@ double Luminance(const Eigen::Vector3d& rgb);
 // (equal channels for the grey styles "contrast" and "none").
 Eigen::Vector3d Albedo(const AppearanceOptions& options, const Eigen::Vector3d& p);
 
-// RGB radiance, every channel in [0, max_albedo], of point p with outward
-// unit normal n seen from the camera centre `eye`:
+// RGB radiance, every channel in [0, 1], of point p with outward unit
+// normal n seen from the camera centre `eye`:
 // albedo * (ambient + (1 - ambient) * max(0, n . l)), where l is the unit
-// world light direction ("world") or (eye - p).normalized() ("headlight").
+// world light direction ("world") or (eye - p).normalized() ("headlight"),
+// plus, where n . l > 0, the white highlight specular * max(0, n . h)^shininess
+// (h the unit vector halfway between l and the direction to the eye),
+// clipped at 1.
 Eigen::Vector3d ShadePoint(const AppearanceOptions& options, const Eigen::Vector3d& p,
                            const Eigen::Vector3d& n, const Eigen::Vector3d& eye);
 
