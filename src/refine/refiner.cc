@@ -1133,7 +1133,7 @@ void RegisterRefineOptions(OptionManager* o, RefineOptions* r) {
          "poses_intrinsics");
   o->Add("Refine.camera_rounds", &r->camera_rounds,
          "with refine_cameras: refinements within the finest level, evenly spaced (>= 1; 1: "
-         "halfway)");
+         "halfway; 2 for cameras known to be off by a pixel or more, at more cost)");
   o->Add("CameraRefinement.max_samples_per_pair", &r->camera_refinement.max_samples_per_pair,
          "pixels sampled per ordered view pair (>= 1)");
   o->Add("CameraRefinement.intensity_sigma", &r->camera_refinement.intensity_sigma,
