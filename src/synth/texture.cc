@@ -176,14 +176,14 @@ Eigen::Vector3d Albedo(const AppearanceOptions& options, const Eigen::Vector3d& 
 
 Eigen::Vector3d ShadePoint(const AppearanceOptions& options, const Eigen::Vector3d& p,
                            const Eigen::Vector3d& n, const Eigen::Vector3d& eye) {
-  const Eigen::Vector3d light = options.light == "headlight"
-                                    ? (eye - p).normalized()
-                                    : options.light_direction.normalized();
+  const Eigen::Vector3d to_eye = (eye - p).normalized();
+  const Eigen::Vector3d light =
+      options.light == "headlight" ? to_eye : options.light_direction.normalized();
   const double lambert = std::max(0.0, n.dot(light));
   const Eigen::Vector3d diffuse =
       Albedo(options, p) * (options.ambient + (1 - options.ambient) * lambert);
   if (options.specular == 0 || lambert == 0) return diffuse;
-  const Eigen::Vector3d half = (light + (eye - p).normalized()).normalized();
+  const Eigen::Vector3d half = (light + to_eye).normalized();
   const double highlight = options.specular * std::pow(std::max(0.0, n.dot(half)), options.shininess);
   return (diffuse + Eigen::Vector3d::Constant(highlight)).cwiseMin(1.0);
 }
