@@ -86,6 +86,12 @@ int main(int argc, char** argv) {
                 "Blinn-Phong exponent of the highlight (larger: sharper), [1, 10000]");
     options.Add("exposure_jitter", &o.exposure_jitter,
                 "standard deviation of the log of a random per-view exposure gain, [0, 1]");
+    options.Add("vignetting", &o.vignetting,
+                "lens vignetting: the corners darkened by this share, 1 - v (r / r_corner)^2, "
+                "the same in every view, [0, 0.9]; 0 = none");
+    options.Add("jpeg_quality", &o.jpeg_quality,
+                "write the images as JPEG of this quality (1-100; view_0000.jpg, masks "
+                "view_0000.jpg.png); 0 = PNG");
     options.Add("Shape.edge_length", &o.builtin.edge_length,
                 "built-in shape: target edge length (scene units)");
     options.Add("Shape.relief_amplitude", &o.builtin.relief_amplitude,

@@ -204,6 +204,24 @@ double ApplyExposureJitter(double sigma, uint32_t seed, uint32_t view_index, Syn
   return gain;
 }
 
+void ApplyVignetting(double strength, SynthImage* image) {
+  MR_CHECK(image != nullptr);
+  MR_CHECK(strength >= 0 && strength <= 0.9) << "vignetting strength " << strength;
+  MR_CHECK_EQ(image->radiance.size(), 3 * static_cast<size_t>(image->width) * image->height);
+  if (strength == 0) return;
+  const double cx = 0.5 * (image->width - 1), cy = 0.5 * (image->height - 1);
+  const double corner_squared = cx * cx + cy * cy;
+  if (!(corner_squared > 0)) return;  // a one-pixel image has no corners
+  for (int row = 0; row < image->height; ++row) {
+    for (int col = 0; col < image->width; ++col) {
+      const double r_squared = (col - cx) * (col - cx) + (row - cy) * (row - cy);
+      const double gain = 1.0 - strength * r_squared / corner_squared;
+      float* pixel = &image->radiance[3 * (static_cast<size_t>(row) * image->width + col)];
+      for (int c = 0; c < 3; ++c) pixel[c] = static_cast<float>(pixel[c] * gain);
+    }
+  }
+}
+
 bool DepthNoiseOptions::Check() const {
   if (!(depth_noise >= 0 && depth_noise <= 0.1)) {
     MR_THROW_INPUT << "DepthNoiseOptions::depth_noise = " << depth_noise

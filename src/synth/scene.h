@@ -97,6 +97,14 @@ void AddImageNoise(double sigma, uint32_t seed, uint32_t view_index, SynthImage*
 // (seed, view_index). sigma in [0, 1]; 0 leaves the image as it is (gain 1).
 double ApplyExposureJitter(double sigma, uint32_t seed, uint32_t view_index, SynthImage* image);
 
+// Darkens the image towards its corners as a lens does (vignetting): every
+// channel of the pixel at distance r from the image centre is multiplied by
+// 1 - strength * (r / r_corner)^2, r_corner the distance to a corner, so the
+// centre keeps its value and the corners keep 1 - strength. The same for
+// every view: the fall-off is fixed in the image, not on the surface.
+// strength in [0, 0.9]; 0 leaves the image as it is.
+void ApplyVignetting(double strength, SynthImage* image);
+
 struct DepthNoiseOptions {
   // Standard deviation of the per-pixel Gaussian depth noise, relative to
   // the depth. Range [0, 0.1].

@@ -296,6 +296,35 @@ TEST(ApplyExposureJitter, ScalesEachViewByItsOwnGain) {
   EXPECT_NEAR(mean, 0, 0.015);
 }
 
+// The fall-off is 1 at the centre, 1 - strength at the corners, quadratic in
+// the distance between, the same for every channel; strength 0 changes
+// nothing.
+TEST(ApplyVignetting, DarkensTowardsTheCornersQuadratically) {
+  SynthImage image;
+  image.width = 5;
+  image.height = 3;
+  image.coverage.assign(15, 1.f);
+  image.radiance.assign(45, 0.8f);
+  SynthImage zero = image;
+  ApplyVignetting(0, &zero);
+  EXPECT_EQ(zero.radiance, image.radiance);
+  SynthImage dark = image;
+  const double strength = 0.4;
+  ApplyVignetting(strength, &dark);
+  auto value = [&](int row, int col, int c) { return dark.radiance[3 * (row * 5 + col) + c]; };
+  for (int c = 0; c < 3; ++c) {
+    EXPECT_FLOAT_EQ(value(1, 2, c), 0.8f);  // the centre
+    for (const auto& [row, col] : {std::pair{0, 0}, {0, 4}, {2, 0}, {2, 4}}) {
+      EXPECT_FLOAT_EQ(value(row, col, c), static_cast<float>(0.8 * (1 - strength)));
+    }
+    // (1, 0): r^2 = 4 of the corner's 5.
+    EXPECT_FLOAT_EQ(value(1, 0, c), static_cast<float>(0.8 * (1 - strength * 4 / 5)));
+  }
+  // Darker the farther out, along a row from the centre.
+  EXPECT_GT(value(1, 2, 0), value(1, 3, 0));
+  EXPECT_GT(value(1, 3, 0), value(1, 4, 0));
+}
+
 TEST(RenderDenseMaps, DepthPixelsBackProjectOntoSurfaceWithDenseConvention) {
   const SynthScene scene = CoarseScene();
   const std::vector<PinholeView> views = SmallRing(scene);

@@ -22,14 +22,22 @@
 namespace mr {
 namespace {
 
-void WritePng(const std::string& path, const cv::Mat& mat) {
+// Encodes `mat` (PNG, or JPEG of jpeg_quality 1-100) and writes it atomically.
+void WriteEncoded(const std::string& path, const cv::Mat& mat, int jpeg_quality = 0) {
   std::vector<uchar> buffer;
-  if (!cv::imencode(".png", mat, buffer)) MR_THROW_INPUT << path << ": PNG encoding failed";
+  const bool jpeg = jpeg_quality > 0;
+  const std::vector<int> params =
+      jpeg ? std::vector<int>{cv::IMWRITE_JPEG_QUALITY, jpeg_quality} : std::vector<int>{};
+  if (!cv::imencode(jpeg ? ".jpg" : ".png", mat, buffer, params)) {
+    MR_THROW_INPUT << path << ": " << (jpeg ? "JPEG" : "PNG") << " encoding failed";
+  }
   WriteFileAtomically(path, [&](std::ostream& out) {
     out.write(reinterpret_cast<const char*>(buffer.data()),
               static_cast<std::streamsize>(buffer.size()));
   });
 }
+
+void WritePng(const std::string& path, const cv::Mat& mat) { WriteEncoded(path, mat); }
 
 TriangleMesh LoadGroundTruth(const SynthesizerOptions& options) {
   TriangleMesh mesh;
@@ -100,6 +108,14 @@ bool SynthesizerOptions::Check() const {
     MR_THROW_INPUT << "SynthesizerOptions::exposure_jitter = " << exposure_jitter
                    << ". Violated constraint: 0 <= exposure_jitter <= 1";
   }
+  if (!(vignetting >= 0 && vignetting <= 0.9)) {
+    MR_THROW_INPUT << "SynthesizerOptions::vignetting = " << vignetting
+                   << ". Violated constraint: 0 <= vignetting <= 0.9";
+  }
+  if (jpeg_quality < 0 || jpeg_quality > 100) {
+    MR_THROW_INPUT << "SynthesizerOptions::jpeg_quality = " << jpeg_quality
+                   << ". Violated constraint: 0 (PNG) or 1 <= jpeg_quality <= 100";
+  }
   if (!(image_noise >= 0 && image_noise <= 0.5)) {
     MR_THROW_INPUT << "SynthesizerOptions::image_noise = " << image_noise
                    << ". Violated constraint: 0 <= image_noise <= 0.5";
@@ -136,13 +152,13 @@ std::string SynthesizerSummary::BriefReport() const {
   return s.str();
 }
 
-std::string SynthViewName(int i) {
+std::string SynthViewName(int i, const std::string& extension) {
   char buffer[32];
-  std::snprintf(buffer, sizeof(buffer), "view_%04d.png", i);
-  return buffer;
+  std::snprintf(buffer, sizeof(buffer), "view_%04d", i);
+  return buffer + extension;
 }
 
-void WriteSynthImagePng(const std::string& path, const SynthImage& image) {
+void WriteSynthImage(const std::string& path, const SynthImage& image, int jpeg_quality) {
   MR_CHECK_EQ(image.radiance.size(), 3 * static_cast<size_t>(image.width) * image.height);
   cv::Mat mat(image.height, image.width, CV_8UC3);
   for (int row = 0; row < image.height; ++row) {
@@ -156,7 +172,7 @@ void WriteSynthImagePng(const std::string& path, const SynthImage& image) {
       mat.at<cv::Vec3b>(row, col) = cv::Vec3b(rgb[2], rgb[1], rgb[0]);  // OpenCV is BGR
     }
   }
-  WritePng(path, mat);
+  WriteEncoded(path, mat, jpeg_quality);
 }
 
 SynthesizerSummary SynthesizeWorkspace(const SynthesizerOptions& options) {
@@ -221,14 +237,16 @@ SynthesizerSummary SynthesizeWorkspace(const SynthesizerOptions& options) {
   Progress progress("Rendering views", static_cast<long>(views.size()));
   double coverage_sum = 0;
   for (size_t i = 0; i < views.size(); ++i) {
-    const std::string name = SynthViewName(static_cast<int>(i));
+    const std::string name =
+        SynthViewName(static_cast<int>(i), options.jpeg_quality > 0 ? ".jpg" : ".png");
     names.push_back(name);
     SynthImage image = RenderImage(renderer, scene, views[i], options.supersample);
+    ApplyVignetting(options.vignetting, &image);
     ApplyExposureJitter(options.exposure_jitter, static_cast<uint32_t>(options.seed),
                         static_cast<uint32_t>(i), &image);
     AddImageNoise(options.image_noise, static_cast<uint32_t>(options.seed),
                   static_cast<uint32_t>(i), &image);
-    WriteSynthImagePng(JoinPaths(images_dir, name), image);
+    WriteSynthImage(JoinPaths(images_dir, name), image, options.jpeg_quality);
     if (options.write_masks) {
       cv::Mat mask(image.height, image.width, CV_8UC1);
       for (int row = 0; row < image.height; ++row) {
@@ -258,8 +276,11 @@ SynthesizerSummary SynthesizeWorkspace(const SynthesizerOptions& options) {
                << options.cameras.height << ", supersample " << options.supersample
                << ", texture " << options.appearance.texture_style << ", light "
                << options.appearance.light << ", specular " << options.appearance.specular
-               << ", exposure jitter " << options.exposure_jitter << ", image noise "
-               << options.image_noise
+               << ", vignetting " << options.vignetting << ", exposure jitter "
+               << options.exposure_jitter << ", image noise " << options.image_noise
+               << (options.jpeg_quality > 0
+                       ? ", JPEG quality " + std::to_string(options.jpeg_quality)
+                       : std::string(", PNG"))
                << ") with depth and normal maps in " << summary.render_seconds << " s";
 
   // Sparse model.

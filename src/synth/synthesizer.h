@@ -57,6 +57,15 @@ struct SynthesizerOptions {
   // and the view index) and clipped at 1, before the noise, as auto-exposure
   // varies between photos. 0 = every view exposed alike. Range [0, 1].
   double exposure_jitter = 0;
+  // Vignetting of the lens: radiance times 1 - vignetting * (r / r_corner)^2
+  // (ApplyVignetting), before the exposure gain; the same in every view.
+  // 0 = none. Range [0, 0.9].
+  double vignetting = 0;
+  // 0: the images are written as PNG ("view_0000.png"). 1-100: as JPEG of
+  // this quality ("view_0000.jpg", masks "view_0000.jpg.png"), with the
+  // compression's blocks and ringing, as photographs and COLMAP's undistorted
+  // images of them are stored.
+  int jpeg_quality = 0;
   // Write COLMAP masks (dense/masks/<image name>.png).
   bool write_masks = true;
   // Maximum number of sparse points3D (each seen in >= 2 views). [0, 1e7].
@@ -100,11 +109,12 @@ struct SynthesizerSummary {
 
 SynthesizerSummary SynthesizeWorkspace(const SynthesizerOptions& options);
 
-// Name of view i: "view_0000.png", ...
-std::string SynthViewName(int i);
+// Name of view i: "view_0000.png", ... ("view_0000.jpg", ... with
+// `extension` ".jpg").
+std::string SynthViewName(int i, const std::string& extension = ".png");
 
-// Writes an 8-bit RGB PNG of `image` (radiance * 255, rounded; grey styles
-// give R = G = B).
-void WriteSynthImagePng(const std::string& path, const SynthImage& image);
+// Writes an 8-bit RGB image of `image` (radiance * 255, rounded; grey styles
+// give R = G = B): PNG for jpeg_quality 0, else JPEG of that quality (1-100).
+void WriteSynthImage(const std::string& path, const SynthImage& image, int jpeg_quality = 0);
 
 }  // namespace mr

@@ -104,6 +104,12 @@ TEST(SynthesizerOptions, RejectsBadImageStyleAndCameraValues) {
                  "specular");
   expect_message(rejects([](SynthesizerOptions* o) { o->exposure_jitter = 1.5; }),
                  "exposure_jitter");
+  for (const double v : {-0.1, 0.95, std::nan("")}) {
+    expect_message(rejects([v](SynthesizerOptions* o) { o->vignetting = v; }), "vignetting");
+  }
+  for (const int q : {-1, 101}) {
+    expect_message(rejects([q](SynthesizerOptions* o) { o->jpeg_quality = q; }), "jpeg_quality");
+  }
   expect_message(rejects([](SynthesizerOptions* o) { o->cameras.focal_factor = 0.05; }),
                  "focal_factor");
   expect_message(rejects([](SynthesizerOptions* o) { o->cameras.focal_factor = 11; }),
@@ -210,7 +216,7 @@ TEST(Synthesizer, WritesWorkspaceAndGroundTruthBesideIt) {
   EXPECT_GT(close, 0.97 * n);
 }
 
-cv::Mat ReadPng(const std::string& path) {
+cv::Mat ReadRgb(const std::string& path) {
   const cv::Mat image = cv::imread(path, cv::IMREAD_UNCHANGED);
   EXPECT_FALSE(image.empty()) << path;
   EXPECT_EQ(image.type(), CV_8UC3) << path;
@@ -234,8 +240,8 @@ TEST(Synthesizer, ImageNoiseReachesTheWrittenImagesOnly) {
   long n = 0;
   for (int i = 0; i < 6; ++i) {
     const std::string name = SynthViewName(i);
-    const cv::Mat a = ReadPng(JoinPaths(clean, "images/" + name));
-    const cv::Mat b = ReadPng(JoinPaths(noisy, "images/" + name));
+    const cv::Mat a = ReadRgb(JoinPaths(clean, "images/" + name));
+    const cv::Mat b = ReadRgb(JoinPaths(noisy, "images/" + name));
     for (int row = 0; row < a.rows; ++row) {
       for (int col = 0; col < a.cols; ++col) {
         const cv::Vec3b pa = a.at<cv::Vec3b>(row, col), pb = b.at<cv::Vec3b>(row, col);
@@ -265,6 +271,74 @@ TEST(Synthesizer, ImageNoiseReachesTheWrittenImagesOnly) {
   }
 }
 
+// --jpeg_quality writes JPEG images under .jpg names, which the sparse model
+// and the masks (<name>.png) follow; they decode to the PNG images up to the
+// compression's error, and the depth maps are the same. --vignetting darkens
+// the corners of every view and leaves the centre.
+TEST(Synthesizer, JpegImagesAndVignettingReachTheWrittenImages) {
+  const std::string dir = FreshDir("jpeg");
+  SynthesizerOptions png_options = SmallOptions(JoinPaths(dir, "png"));
+  SynthesizerOptions jpeg_options = SmallOptions(JoinPaths(dir, "jpeg"));
+  jpeg_options.jpeg_quality = 90;
+  SynthesizerOptions vignetted_options = SmallOptions(JoinPaths(dir, "vignetted"));
+  vignetted_options.vignetting = 0.5;
+  SynthesizeWorkspace(png_options);
+  SynthesizeWorkspace(jpeg_options);
+  SynthesizeWorkspace(vignetted_options);
+  const std::string png = JoinPaths(png_options.output_path, "dense");
+  const std::string jpeg = JoinPaths(jpeg_options.output_path, "dense");
+  const std::string vignetted = JoinPaths(vignetted_options.output_path, "dense");
+  const Reconstruction model = ReadSparseModelBinary(JoinPaths(jpeg, "sparse"));
+  ASSERT_EQ(model.images.size(), 6u);
+  for (const auto& [id, image] : model.images) {
+    EXPECT_EQ(image.name.substr(image.name.size() - 4), ".jpg") << image.name;
+  }
+  double abs_sum = 0;
+  long n = 0;
+  long mismatched = 0, lit_off_centre = 0;  // vignetting: pixels off the fall-off, object pixels
+  for (int i = 0; i < 6; ++i) {
+    const std::string name = SynthViewName(i, ".jpg");
+    EXPECT_EQ(name, "view_000" + std::to_string(i) + ".jpg");
+    const std::string bytes = ReadFileToString(JoinPaths(jpeg, "images/" + name));
+    ASSERT_GE(bytes.size(), 3u);
+    EXPECT_EQ(static_cast<unsigned char>(bytes[0]), 0xFF);  // a JPEG's start-of-image marker
+    EXPECT_EQ(static_cast<unsigned char>(bytes[1]), 0xD8);
+    EXPECT_TRUE(ExistsFile(JoinPaths(jpeg, "masks/" + name + ".png")));
+    EXPECT_EQ(ReadFileToString(JoinPaths(jpeg, "masks/" + name + ".png")),
+              ReadFileToString(JoinPaths(png, "masks/" + SynthViewName(i) + ".png")));
+    EXPECT_EQ(
+        ReadFileToString(JoinPaths(jpeg, "stereo/depth_maps/" + name + ".geometric.bin")),
+        ReadFileToString(JoinPaths(png, "stereo/depth_maps/" + SynthViewName(i) + ".geometric.bin")));
+    const cv::Mat a = ReadRgb(JoinPaths(png, "images/" + SynthViewName(i)));
+    const cv::Mat b = ReadRgb(JoinPaths(jpeg, "images/" + name));
+    ASSERT_EQ(a.size(), b.size());
+    cv::Mat diff;
+    cv::absdiff(a, b, diff);
+    abs_sum += cv::sum(diff)[0] + cv::sum(diff)[1] + cv::sum(diff)[2];
+    n += 3L * a.rows * a.cols;
+
+    const cv::Mat v = ReadRgb(JoinPaths(vignetted, "images/" + SynthViewName(i)));
+    ASSERT_EQ(a.size(), v.size());
+    // Every pixel is the PNG's times 1 - 0.5 (r / r_corner)^2, up to the
+    // rounding of the two 8-bit images.
+    const double cx = 0.5 * (a.cols - 1), cy = 0.5 * (a.rows - 1);
+    for (int row = 0; row < a.rows; ++row) {
+      for (int col = 0; col < a.cols; ++col) {
+        const double r2 = ((col - cx) * (col - cx) + (row - cy) * (row - cy)) / (cx * cx + cy * cy);
+        const double expected = a.at<cv::Vec3b>(row, col)[0] * (1 - 0.5 * r2);
+        const int got = v.at<cv::Vec3b>(row, col)[0];
+        if (std::abs(got - expected) > 1.0) ++mismatched;
+        if (a.at<cv::Vec3b>(row, col)[0] >= 60 && r2 >= 0.09) ++lit_off_centre;
+      }
+    }
+  }
+  EXPECT_EQ(mismatched, 0);
+  EXPECT_GT(lit_off_centre, 300);  // object pixels where the fall-off exceeds the tolerance
+  const double mean_abs = abs_sum / n;
+  EXPECT_GT(mean_abs, 0.05);  // compressed, not a copy
+  EXPECT_LT(mean_abs, 3.0);   // grey levels of 255
+}
+
 // smooth_color writes colour PNGs (in RGB order: the point colours, taken
 // from the rendered radiance, match the pixels read back) under a headlight.
 TEST(Synthesizer, SmoothColorWritesColourImagesAndPointColours) {
@@ -276,7 +350,7 @@ TEST(Synthesizer, SmoothColorWritesColourImagesAndPointColours) {
   const std::string dense = JoinPaths(dir, "dense");
   std::vector<cv::Mat> images;
   for (int i = 0; i < 6; ++i) {
-    images.push_back(ReadPng(JoinPaths(dense, "images/" + SynthViewName(i))));
+    images.push_back(ReadRgb(JoinPaths(dense, "images/" + SynthViewName(i))));
   }
   int coloured = 0, object = 0;
   for (int row = 0; row < images[0].rows; ++row) {
