@@ -116,6 +116,10 @@ void ApplyEnvOverrides(mr::DenoiseOptions* o) {
   o->l0_beta_factor = env("L0K", o->l0_beta_factor);
   o->l0_alpha_factor = env("L0AF", o->l0_alpha_factor);
   o->l0_alpha_decay = env("L0AD", o->l0_alpha_decay);
+  o->outer_iterations = static_cast<int>(env("BNOUT", o->outer_iterations));
+  o->normal_iterations = static_cast<int>(env("BNNI", o->normal_iterations));
+  o->vertex_iterations = static_cast<int>(env("BNVI", o->vertex_iterations));
+  o->normal_sigma = env("BNSR", o->normal_sigma);
   o->l0_update_operator = env("L0UPD", o->l0_update_operator ? 1 : 0) != 0;
 }
 

@@ -85,27 +85,18 @@ Eigen::MatrixXd LaplacianSmooth(const Eigen::MatrixXd& V, const Eigen::MatrixXi&
   return X;
 }
 
-Eigen::MatrixXd BilateralNormalFilter(const Eigen::MatrixXd& V, const Eigen::MatrixXi& F,
-                                      int normal_iterations, int vertex_iterations,
-                                      double normal_sigma, double spatial_sigma) {
-  const int n = static_cast<int>(V.rows()), nf = static_cast<int>(F.rows());
-  if (nf == 0) return V;
-  const Csr vf = VertexFaces(F, n);
-  // Face neighbourhoods: faces sharing a vertex (Zheng et al.'s local scheme).
-  std::vector<std::vector<int>> ring(nf);
-#pragma omp parallel for schedule(dynamic, 256) if (nf > 50000)
-  for (int f = 0; f < nf; ++f) {
-    std::vector<int>& r = ring[f];
-    for (int k = 0; k < 3; ++k) {
-      const int v = F(f, k);
-      for (int j = vf.offset[v]; j < vf.offset[v + 1]; ++j) {
-        if (vf.adj[j] != f) r.push_back(vf.adj[j]);
-      }
-    }
-    std::sort(r.begin(), r.end());
-    r.erase(std::unique(r.begin(), r.end()), r.end());
-  }
-  Eigen::MatrixXd X = V;
+namespace {
+
+// One round of BilateralNormalFilter on X: normals, centroids, areas and the
+// spatial sigma from X, then the normal filtering and the vertex fitting.
+// `vf` are the faces of each vertex, `ring` the faces sharing a vertex with
+// each face.
+void BilateralNormalRound(const Eigen::MatrixXi& F, const Csr& vf,
+                          const std::vector<std::vector<int>>& ring, int normal_iterations,
+                          int vertex_iterations, double normal_sigma, double spatial_sigma,
+                          Eigen::MatrixXd* X_in_out) {
+  Eigen::MatrixXd& X = *X_in_out;
+  const int n = static_cast<int>(X.rows()), nf = static_cast<int>(F.rows());
   auto centroids_normals_areas = [&](Eigen::MatrixXd* C, Eigen::MatrixXd* N, Eigen::VectorXd* A) {
     C->resize(nf, 3);
     N->resize(nf, 3);
@@ -168,6 +159,36 @@ Eigen::MatrixXd BilateralNormalFilter(const Eigen::MatrixXd& V, const Eigen::Mat
     for (int f = 0; f < nf; ++f) {
       C.row(f) = FaceCentroid(X, F, f).transpose();
     }
+  }
+}
+
+}  // namespace
+
+Eigen::MatrixXd BilateralNormalFilter(const Eigen::MatrixXd& V, const Eigen::MatrixXi& F,
+                                      int normal_iterations, int vertex_iterations,
+                                      double normal_sigma, double spatial_sigma,
+                                      int outer_iterations) {
+  const int n = static_cast<int>(V.rows()), nf = static_cast<int>(F.rows());
+  if (nf == 0) return V;
+  const Csr vf = VertexFaces(F, n);
+  // Face neighbourhoods: faces sharing a vertex (Zheng et al.'s local scheme).
+  std::vector<std::vector<int>> ring(nf);
+#pragma omp parallel for schedule(dynamic, 256) if (nf > 50000)
+  for (int f = 0; f < nf; ++f) {
+    std::vector<int>& r = ring[f];
+    for (int k = 0; k < 3; ++k) {
+      const int v = F(f, k);
+      for (int j = vf.offset[v]; j < vf.offset[v + 1]; ++j) {
+        if (vf.adj[j] != f) r.push_back(vf.adj[j]);
+      }
+    }
+    std::sort(r.begin(), r.end());
+    r.erase(std::unique(r.begin(), r.end()), r.end());
+  }
+  Eigen::MatrixXd X = V;
+  for (int round = 0; round < outer_iterations; ++round) {
+    BilateralNormalRound(F, vf, ring, normal_iterations, vertex_iterations, normal_sigma,
+                         spatial_sigma, &X);
   }
   return X;
 }

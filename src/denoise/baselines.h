@@ -16,10 +16,14 @@ Eigen::MatrixXd LaplacianSmooth(const Eigen::MatrixXd& V, const Eigen::MatrixXi&
 
 // Bilateral normal filtering (Zheng et al., TVCG 2011, local iterative
 // scheme) over the faces sharing a vertex, followed by the iterative vertex
-// update of Sun et al. 2007. `spatial_sigma` is in mean distances between the
-// centroids of edge-adjacent faces; `normal_sigma` acts on |n_i - n_j|.
+// update of Sun et al. 2007; `outer_iterations` times, the face normals,
+// centroids and areas recomputed from the updated vertices each time (so
+// that two outer iterations are the filter applied twice). `spatial_sigma`
+// is in mean distances between the centroids of faces sharing a vertex, taken
+// from the input; `normal_sigma` acts on |n_i - n_j|.
 Eigen::MatrixXd BilateralNormalFilter(const Eigen::MatrixXd& V, const Eigen::MatrixXi& F,
                                       int normal_iterations, int vertex_iterations,
-                                      double normal_sigma, double spatial_sigma);
+                                      double normal_sigma, double spatial_sigma,
+                                      int outer_iterations = 1);
 
 }  // namespace mr

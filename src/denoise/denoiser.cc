@@ -248,6 +248,7 @@ bool DenoiseOptions::Check() const {
   MR_CHECK_OPTION(bilaplacian_weight >= 0, bilaplacian_weight, "bilaplacian_weight >= 0");
   MR_CHECK_OPTION(2 * laplacian_weight + 4 * bilaplacian_weight < 2, bilaplacian_weight,
                   "2 laplacian_weight + 4 bilaplacian_weight < 2 (stability)");
+  MR_CHECK_OPTION(outer_iterations >= 1, outer_iterations, "outer_iterations >= 1");
   MR_CHECK_OPTION(normal_iterations >= 0, normal_iterations, "normal_iterations >= 0");
   MR_CHECK_OPTION(vertex_iterations >= 0, vertex_iterations, "vertex_iterations >= 0");
   MR_CHECK_OPTION(normal_sigma > 0, normal_sigma, "normal_sigma > 0");
@@ -318,7 +319,8 @@ DenoiseResult Denoise(const Eigen::MatrixXd& V0, const Eigen::MatrixXi& F,
                                options.bilaplacian_weight);
   } else {
     result.V = BilateralNormalFilter(V0, F, options.normal_iterations, options.vertex_iterations,
-                                     options.normal_sigma, options.spatial_sigma);
+                                     options.normal_sigma, options.spatial_sigma,
+                                     options.outer_iterations);
   }
   result.total_seconds = Now() - t0;
   result.solve_seconds = result.total_seconds - result.setup_seconds;
@@ -363,10 +365,13 @@ void RegisterDenoiseOptions(OptionManager* m, DenoiseOptions* o, const std::stri
   m->Add(name("laplacian_weight"), &o->laplacian_weight, "laplacian: first-order weight, (0, 1]");
   m->Add(name("bilaplacian_weight"), &o->bilaplacian_weight,
          "laplacian: second-order weight, >= 0, 2 w1 + 4 w2 < 2");
+  m->Add(name("outer_iterations"), &o->outer_iterations,
+         "bilateral_normal: rounds of normal filtering then vertex fitting, the normals "
+         "recomputed from the vertices each round, >= 1");
   m->Add(name("normal_iterations"), &o->normal_iterations,
-         "bilateral_normal: normal filtering passes, >= 0");
+         "bilateral_normal: normal filtering passes per round, >= 0");
   m->Add(name("vertex_iterations"), &o->vertex_iterations,
-         "bilateral_normal: vertex update passes, >= 0");
+         "bilateral_normal: vertex update passes per round, >= 0");
   m->Add(name("normal_sigma"), &o->normal_sigma, "bilateral_normal: range sigma on |n_i - n_j|");
   m->Add(name("spatial_sigma"), &o->spatial_sigma,
          "bilateral_normal: spatial sigma in mean centroid distances");

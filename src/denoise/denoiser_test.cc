@@ -5,7 +5,9 @@
 #include <Eigen/Geometry>
 #include <gtest/gtest.h>
 
+#include "denoise/baselines.h"
 #include "denoise/synthetic_meshes.h"
+#include "colmap_io/mesh_io.h"
 #include "geometry/mesh.h"
 #include "util/error.h"
 
@@ -259,6 +261,45 @@ TEST(Denoise, BaselinesReduceNoise) {
   EXPECT_LT(MeanAngleDeg(Denoise(noisy, F, o).V, clean, F), 0.8 * before);
   o.method = "bilateral_normal";
   EXPECT_LT(MeanAngleDeg(Denoise(noisy, F, o).V, clean, F), 0.3 * before);
+}
+
+// Zheng et al.'s outer iterations recompute the face normals, centroids and
+// areas from the vertices the last one fitted: k outer iterations are the
+// one-round filter applied k times.
+TEST(BilateralNormalFilter, OuterIterationsApplyTheRoundAgain) {
+  Eigen::MatrixXd clean, noisy;
+  Eigen::MatrixXi F;
+  NoisyCube(&clean, &noisy, &F);
+  const Eigen::MatrixXd three = BilateralNormalFilter(noisy, F, 1, 4, 0.8, 1.0, 3);
+  Eigen::MatrixXd once = noisy;
+  for (int k = 0; k < 3; ++k) once = BilateralNormalFilter(once, F, 1, 4, 0.8, 1.0, 1);
+  EXPECT_LT((three - once).cwiseAbs().maxCoeff(), 1e-12);
+  EXPECT_GT((three - BilateralNormalFilter(noisy, F, 1, 4, 0.8, 1.0, 1)).cwiseAbs().maxCoeff(),
+            1e-4);
+}
+
+// The bilateral_normal defaults were chosen on the denoising benchmark's
+// organic models (docs/denoising.md); a guard that they keep what they were
+// chosen for: on the Stanford bunny with the benchmark's noise (0.3 mean
+// edges along the normals, seed 1) they beat Laplacian smoothing at every
+// iteration count around its best (6: 6.27 degrees; the defaults 5.99).
+TEST(Denoise, BilateralNormalDefaultsBeatLaplacianAtAnyCountOnTheBunny) {
+  const TriangleMesh bunny = ReadMesh(MR_SHARED_DIR "/data/models/stanford-bunny.obj");
+  const Eigen::MatrixXd noisy =
+      AddNormalNoise(bunny.V, bunny.F, 0.3 * MeanEdgeLength(bunny.V, bunny.F), 1);
+  DenoiseOptions bilateral;
+  bilateral.method = "bilateral_normal";
+  const double e_bilateral = MeanAngleDeg(Denoise(noisy, bunny.F, bilateral).V, bunny.V, bunny.F);
+  double e_laplacian_best = 1e9;
+  DenoiseOptions laplacian;
+  laplacian.method = "laplacian";
+  for (int iterations : {2, 4, 6, 8, 10, 15}) {
+    laplacian.laplacian_iterations = iterations;
+    e_laplacian_best = std::min(
+        e_laplacian_best, MeanAngleDeg(Denoise(noisy, bunny.F, laplacian).V, bunny.V, bunny.F));
+  }
+  EXPECT_LT(e_bilateral, e_laplacian_best);
+  EXPECT_NEAR(e_laplacian_best, 6.27, 0.05);  // the benchmark's oracle figure
 }
 
 TEST(Denoise, RotationTranslationAndScaleInvariant) {

@@ -52,8 +52,10 @@ inline DenoiseOptions ProximalDenoiseOptions() {
   options.inner_iterations = 1;
   options.lambda_scale = 10.0;
   options.laplacian_iterations = 1;
+  options.outer_iterations = 1;
   options.normal_iterations = 2;
   options.vertex_iterations = 10;
+  options.normal_sigma = 0.35;
   return options;
 }
 
