@@ -308,6 +308,8 @@ std::vector<BadInput> Table() {
        kWs + " --Refine.refine_cameras all", 1,
        "RefineOptions::refine_cameras = all. Violated constraint: one of none, poses, "
        "poses_intrinsics"},
+      {"RefinerLightUnknown", R, "`--Refine.light sun`", kNothing, kWs + " --Refine.light sun", 1,
+       "RefineOptions::light = sun. Violated constraint: one of world, headlight, auto"},
       {"RefinerOptionNotANumber", R, "`--Refine.step abc`", kNothing, kWs + " --Refine.step abc",
        1, "--Refine.step abc: expected a finite number"},
       {"RefinerOptionNaN", R, "`--Refine.step nan`", kNothing, kWs + " --Refine.step nan", 1,

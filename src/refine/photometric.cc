@@ -133,7 +133,19 @@ bool PairTermOptions::Check() const {
     MR_THROW_INPUT << "PairTermOptions::interpolation = " << interpolation
                    << ". Violated constraint: interpolation is cubic or bilinear";
   }
+  if (!(headlight_ambient < 0 || headlight_ambient <= 1)) {
+    MR_THROW_INPUT << "PairTermOptions::headlight_ambient = " << headlight_ambient
+                   << ". Violated constraint: negative (a light fixed in the world) or in [0, 1]";
+  }
   return true;
+}
+
+double HeadlightRelighting(double ambient, const Eigen::Vector3d& n, const Eigen::Vector3d& x,
+                           const Eigen::Vector3d& center_i, const Eigen::Vector3d& center_j) {
+  const double cos_i = std::max(0.0, n.dot((center_i - x).normalized()));
+  const double cos_j = std::max(0.0, n.dot((center_j - x).normalized()));
+  const double lit_i = ambient + (1 - ambient) * cos_i, lit_j = ambient + (1 - ambient) * cos_j;
+  return lit_j > 0 ? lit_i / lit_j : 1.0;
 }
 
 void DataTerm::Reset(int num_vertices) {
@@ -202,6 +214,8 @@ void WarpImage(const MeshGeometry& mesh, const PinholeView& view_i, const Render
   mask->create(box.size(), CV_8U);
   if (blur_i != nullptr) blur_i->create(box.size(), CV_32F);
   const bool cubic = options.interpolation == "cubic";
+  const bool headlight = options.headlight_ambient >= 0;
+  const Eigen::Vector3d center_i = view_i.Center(), center_j = view_j.Center();
   Eigen::Matrix<double, 3, 2> dray;  // ∂r/∂p, the same for every pixel of view i
   dray.col(0) = view_i.R.row(0).transpose() / view_i.fx;
   dray.col(1) = view_i.R.row(1).transpose() / view_i.fy;
@@ -232,11 +246,17 @@ void WarpImage(const MeshGeometry& mesh, const PinholeView& view_i, const Render
         blur_j = MatchingBlurPx(ratio);
         blur_i->at<float>(r, c) = static_cast<float>(MatchingBlurPx(1 / ratio));
       }
+      const double relight =
+          headlight ? HeadlightRelighting(options.headlight_ambient, n,
+                                          center_i + warp.depth * warp.ray, center_i, center_j)
+                    : 1.0;
       Eigen::Vector2d grad_j;
-      predicted->at<double>(r, c) = SampleBlurred(image_j, warp.q.x(), warp.q.y(), blur_j, cubic,
-                                                  derivative != nullptr ? &grad_j : nullptr);
+      predicted->at<double>(r, c) =
+          relight * SampleBlurred(image_j, warp.q.x(), warp.q.y(), blur_j, cubic,
+                                  derivative != nullptr ? &grad_j : nullptr);
       if (derivative == nullptr) continue;
-      derivative->at<double>(r, c) = grad_j.dot(warp.jacobian_j * warp.ray) / n.dot(warp.ray);
+      derivative->at<double>(r, c) =
+          relight * grad_j.dot(warp.jacobian_j * warp.ray) / n.dot(warp.ray);
       footprint->at<double>(r, c) = warp.depth / view_i.fx;
     }
   }

@@ -65,8 +65,23 @@ struct PairTermOptions {
   // Compare each pixel at the coarser of the two views' resolutions on the
   // surface there (above).
   bool match_resolution = true;
+  // Where the light is. Negative: fixed in the world (the sun, a room's
+  // lamps), which shades a surface point alike in every view. In [0, 1]: at
+  // the camera (a flash, a ring light), with this share of ambient light; a
+  // point is then shaded by the angle to each camera, and image j's value is
+  // relit to view i by HeadlightRelighting. The factor follows the mesh's
+  // normals but is held fixed in the derivative.
+  double headlight_ambient = -1;
   bool Check() const;
 };
+
+// The factor that relights a surface point seen by view j to view i under a
+// light at the camera with ambient share `ambient`:
+// (a + (1 - a) max(0, n.v_i)) / (a + (1 - a) max(0, n.v_j)), v the unit
+// directions from the point x to the camera centres, n the unit normal.
+// 1 where the point faces neither camera (0 / 0 for ambient 0).
+double HeadlightRelighting(double ambient, const Eigen::Vector3d& n, const Eigen::Vector3d& x,
+                           const Eigen::Vector3d& center_i, const Eigen::Vector3d& center_j);
 
 // Per-vertex sums over pixels and pairs.
 struct DataTerm {

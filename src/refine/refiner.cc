@@ -295,9 +295,36 @@ DataTerm ComputeDataTerm(const MeshGeometry& mesh, const std::vector<PinholeView
   return accumulator.Sum();
 }
 
-// Mean plain-ZNCC similarity of all pairs at full resolution through (V, F).
-// `visit` (optional) sees each render of a view in a pair, as in
-// ComputeDataTerm.
+// `value` with `digits` significant digits, for a log line.
+std::string FormatShort(double value, int digits = 3) {
+  std::ostringstream out;
+  out << std::setprecision(digits) << value;
+  return out.str();
+}
+
+// Mean plain-ZNCC similarity of all pairs at pyramid `level` through (V, F);
+// `views` are the full-resolution ones. `visit` (optional) sees each render
+// of a view in a pair, as in ComputeDataTerm.
+double MeanSimilarityAtLevel(const std::vector<PinholeView>& views,
+                             const std::vector<std::pair<int, int>>& pairs,
+                             const SimilarityOptions& similarity,
+                             const PairTermOptions& pair_options, const Eigen::MatrixXd& V,
+                             const Eigen::MatrixXi& F, Renderer* renderer, size_t cache_bytes,
+                             ImageCache* images, int level,
+                             const std::function<void(int, const RenderBuffers&)>& visit = {}) {
+  const std::vector<PinholeView> level_views = LevelViews(views, level);
+  RenderCache renders(renderer, level_views, cache_bytes);
+  renderer->SetMesh(V, F);
+  MeshGeometry geometry{&V, &F, FaceNormals(V, F)};
+  SimilarityOptions plain = similarity;
+  plain.method = "zncc";
+  plain.kappa = 0;
+  return ComputeDataTerm(geometry, level_views, pairs, level, plain, pair_options, &renders,
+                         images, /*with_gradient=*/false, visit)
+      .MeanSimilarity();
+}
+
+// The same at full resolution.
 double FullResolutionSimilarity(const std::vector<PinholeView>& views,
                                 const std::vector<std::pair<int, int>>& pairs,
                                 const SimilarityOptions& similarity,
@@ -305,15 +332,8 @@ double FullResolutionSimilarity(const std::vector<PinholeView>& views,
                                 const Eigen::MatrixXi& F, Renderer* renderer, size_t cache_bytes,
                                 ImageCache* images,
                                 const std::function<void(int, const RenderBuffers&)>& visit = {}) {
-  RenderCache renders(renderer, views, cache_bytes);
-  renderer->SetMesh(V, F);
-  MeshGeometry geometry{&V, &F, FaceNormals(V, F)};
-  SimilarityOptions plain = similarity;
-  plain.method = "zncc";
-  plain.kappa = 0;
-  return ComputeDataTerm(geometry, views, pairs, 0, plain, pair_options, &renders, images,
-                         /*with_gradient=*/false, visit)
-      .MeanSimilarity();
+  return MeanSimilarityAtLevel(views, pairs, similarity, pair_options, V, F, renderer,
+                               cache_bytes, images, 0, visit);
 }
 
 // Per-vertex colours: the mean colour of each vertex over the views where
@@ -568,6 +588,12 @@ bool RefineOptions::Check() const {
     fail("regularizer", regularizer, "one of lp, laplacian, bilateral_normal, none");
   }
   if (!(silhouette_weight >= 0)) fail("silhouette_weight", std::to_string(silhouette_weight), "silhouette_weight >= 0");
+  if (light != "world" && light != "headlight" && light != "auto") {
+    fail("light", light, "one of world, headlight, auto");
+  }
+  if (!(light_ambient >= 0 && light_ambient <= 1)) {
+    fail("light_ambient", std::to_string(light_ambient), "0 <= light_ambient <= 1");
+  }
   if (cache_mb < 64) fail("cache_mb", std::to_string(cache_mb), "cache_mb >= 64");
   background_mask.Check();
   mask_outline.Check();
@@ -721,6 +747,47 @@ RefineSummary RefineMesh(const ViewSource& input_source, const RefineOptions& op
   DenoiseOptions denoise = options.denoise;
   denoise.method = options.regularizer == "none" ? "lp" : options.regularizer;
 
+  // Where the light is: given, or the candidate under which the input
+  // explains the images best.
+  PairTermOptions pair = options.pair;
+  pair.headlight_ambient = options.light == "headlight" ? options.light_ambient : -1;
+  if (options.light == "auto") {
+    // At half resolution (a quarter of the full-resolution pass's pixels):
+    // a fixed light against one at the camera with half the light ambient,
+    // and only if the camera's wins, two more ambient shares.
+    const double t0 = ElapsedSeconds();
+    const int level = std::min(cameras[0].width, cameras[0].height) >= 256 ? 1 : 0;
+    std::ostringstream tried;
+    double best = -std::numeric_limits<double>::infinity();
+    auto try_light = [&](double ambient) {
+      PairTermOptions candidate = options.pair;
+      candidate.headlight_ambient = ambient;
+      const double s = MeanSimilarityAtLevel(cameras, pairs, similarity, candidate, V, F,
+                                             renderer, cache_bytes / 2, &images, level);
+      tried << (ambient < 0 ? "world " : ", headlight " + FormatShort(ambient) + " ")
+            << FormatShort(s, 4);
+      if (s > best) best = s, pair.headlight_ambient = ambient;
+    };
+    try_light(-1.0);
+    try_light(0.5);
+    if (pair.headlight_ambient >= 0) {
+      try_light(0.75);
+      try_light(0.25);
+    }
+    summary.light = pair.headlight_ambient < 0
+                        ? std::string("fixed in the world")
+                        : "at the camera, ambient share " + FormatShort(pair.headlight_ambient);
+    summary.light += " (auto: the input's mean similarity at pyramid level " +
+                     std::to_string(level) + ", " + tried.str() + "; " +
+                     FormatShort(ElapsedSeconds() - t0) + " s)";
+    MR_LOG(INFO) << "Light: " << summary.light;
+  } else {
+    summary.light = options.light == "world"
+                        ? "fixed in the world (given)"
+                        : "at the camera, ambient share " + FormatShort(options.light_ambient) +
+                              " (given)";
+  }
+
   // The schedule: how many pyramid levels, from the input's similarity at
   // each level (ChooseNumLevels), unless num_levels is given.
   int num_levels = options.num_levels;
@@ -758,7 +825,7 @@ RefineSummary RefineMesh(const ViewSource& input_source, const RefineOptions& op
   const bool initial_from_first_iteration = num_levels == 1 && options.iterations_per_level > 0;
   if (!initial_from_first_iteration) {
     summary.initial_similarity = FullResolutionSimilarity(
-        cameras, pairs, similarity, options.pair, V, F, renderer, cache_bytes / 2, &images);
+        cameras, pairs, similarity, pair, V, F, renderer, cache_bytes / 2, &images);
     MR_LOG(INFO) << "Initial mean similarity (ZNCC, full resolution): "
                  << summary.initial_similarity;
   }
@@ -863,7 +930,7 @@ RefineSummary RefineMesh(const ViewSource& input_source, const RefineOptions& op
       const auto& iteration_pairs = all_pairs ? pairs : pair_halves[(it - 1) % 2];
       record.num_pairs = static_cast<int>(iteration_pairs.size());
       const DataTerm term = ComputeDataTerm(geometry, views, iteration_pairs, level, similarity,
-                                            options.pair, &renders, &images,
+                                            pair, &renders, &images,
                                             /*with_gradient=*/true, visit);
       record.data_seconds = ElapsedSeconds() - t_iter - silhouette_seconds;
       record.mean_similarity = term.MeanSimilarity();
@@ -1063,7 +1130,7 @@ RefineSummary RefineMesh(const ViewSource& input_source, const RefineOptions& op
   }
   VertexColorSampler colors(source, cameras, V, F);
   summary.final_similarity = FullResolutionSimilarity(
-      cameras, pairs, similarity, options.pair, V, F, renderer, cache_bytes / 2, &images,
+      cameras, pairs, similarity, pair, V, F, renderer, cache_bytes / 2, &images,
       [&colors](int i, const RenderBuffers& render) { colors.Add(i, render); });
   const SurfaceDisplacement moved = MeasureSurfaceDisplacement(V, V_input, F_input);
   summary.mean_displacement = moved.mean;
@@ -1122,6 +1189,11 @@ void RegisterRefineOptions(OptionManager* o, RefineOptions* r) {
   o->Add("Refine.match_resolution", &r->pair.match_resolution,
          "compare each pixel at the coarser of the two views' resolutions on the surface (the "
          "sharper image blurred by the difference of their pixel footprints)");
+  o->Add("Refine.light", &r->light,
+         "where the light is: world (fixed), headlight (at the camera: flash, ring light) or "
+         "auto (chosen by the input's similarity)");
+  o->Add("Refine.light_ambient", &r->light_ambient,
+         "light headlight: share of ambient light, [0, 1]");
   o->Add("Refine.color", &r->color,
          "images compared on: luminance, or principal (colour direction of most texture)");
   o->Add("Refine.kappa", &r->kappa, "final weight of the detail-preserving term (>= 0)");

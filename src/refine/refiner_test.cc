@@ -229,6 +229,31 @@ TEST_F(RefinerTest, GroundTruthStaysGroundTruth) {
       << "relief RMS " << relief_before << " -> " << relief_after;
 }
 
+// --Refine.light auto tells a light at the camera from one fixed in the
+// world by the input's similarity, on the same object: a ring of views lit
+// by a light fixed in the world, and the same views lit from each camera.
+TEST_F(RefinerTest, LightAutoTellsAHeadlightFromAFixedLight) {
+  Eigen::MatrixXd V;
+  Eigen::MatrixXi F;
+  MakeBumpySphere(4, 0.06, &V, &F);
+  RefineOptions options;
+  options.light = "auto";
+  options.iterations_per_level = 1;
+  options.masks_from_background = false;
+  for (const bool headlight : {false, true}) {
+    TestSceneOptions scene;
+    scene.headlight = headlight;
+    const InMemoryViewSource source = MakeTestScene(V, F, scene, {}, renderer_);
+    TriangleMesh mesh;
+    mesh.V = V;
+    mesh.F = F;
+    const RefineSummary summary = RefineMesh(source, options, &mesh, renderer_);
+    std::printf("headlight %d: %s\n", headlight, summary.light.c_str());
+    EXPECT_EQ(summary.light.rfind(headlight ? "at the camera" : "fixed in the world", 0), 0u)
+        << summary.light;
+  }
+}
+
 // The bumpy sphere (V, F) that the test scene shows, and the smooth sphere
 // (V0, F0) to start from: the relief must be recovered from the images.
 void MakeBumpyAndSmoothSpheres(Eigen::MatrixXd* V, Eigen::MatrixXi* F, Eigen::MatrixXd* V0,

@@ -73,7 +73,8 @@ InMemoryViewSource MakeTestScene(const Eigen::MatrixXd& V, const Eigen::MatrixXi
         const double u = render.bary[2 * idx], v = render.bary[2 * idx + 1];
         const Eigen::Vector3d x = (1 - u - v) * V.row(F(f, 0)) + u * V.row(F(f, 1)) +
                                   v * V.row(F(f, 2));
-        const double shade = 0.35 + 0.65 * std::max(0.0, N.row(f).dot(light));
+        const Eigen::Vector3d towards_light = options.headlight ? (c - x).normalized() : light;
+        const double shade = 0.35 + 0.65 * std::max(0.0, N.row(f).dot(towards_light));
         hi.at<float>(r, col) = static_cast<float>(Albedo(x) * shade);
       }
     }

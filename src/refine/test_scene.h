@@ -32,6 +32,8 @@ struct TestSceneOptions {
   double elevation_deg = 25;
   double distance = 4.0;  // camera distance, in units of the object radius (~1)
   int supersample = 2;
+  // Lit from each camera (a flash) instead of by a light fixed in the world.
+  bool headlight = false;
 };
 
 // A closed bumpy sphere of radius ~1 (icosphere with radial relief
