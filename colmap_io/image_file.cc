@@ -7,6 +7,7 @@
 #include <cstdlib>
 #include <filesystem>
 #include <limits>
+#include <vector>
 
 #include <opencv2/imgcodecs.hpp>
 
@@ -259,6 +260,26 @@ cv::Mat DecodeImageFile(const std::string& path, const std::string& data, int fl
                    << " (not an image format OpenCV reads, or corrupt)";
   }
   return image;
+}
+
+void WriteImageFile(const std::string& path, const cv::Mat& image, int jpeg_quality) {
+  CreateDirIfNotExists(GetParentDir(path));
+  std::vector<uchar> buffer;
+  std::string ext = GetExtension(path);
+  if (ext.empty()) ext = ".png";
+  std::vector<int> params;
+  if (ext == ".jpg" || ext == ".jpeg") params = {cv::IMWRITE_JPEG_QUALITY, jpeg_quality};
+  bool ok = false;
+  try {
+    ok = cv::imencode(ext, image, buffer, params);
+  } catch (const cv::Exception& e) {
+    ok = false;
+  }
+  if (!ok) MR_THROW_INPUT << path << ": cannot encode the image as '" << ext << "'";
+  WriteFileAtomically(path, [&](std::ostream& out) {
+    out.write(reinterpret_cast<const char*>(buffer.data()),
+              static_cast<std::streamsize>(buffer.size()));
+  });
 }
 
 }  // namespace mr

@@ -51,4 +51,10 @@ cv::Mat ReadImageFile(const std::string& path, int flags, const std::string& wha
 cv::Mat DecodeImageFile(const std::string& path, const std::string& data, int flags,
                         const std::string& what = "image");
 
+// Writes `image` to `path` atomically (a temporary beside it, then renamed),
+// creating the folder, in the format of the path's extension (PNG when it has
+// none); `jpeg_quality` (1-100) is used for .jpg and .jpeg. Throws InputError
+// naming `path` if OpenCV cannot encode the image in that format.
+void WriteImageFile(const std::string& path, const cv::Mat& image, int jpeg_quality = 95);
+
 }  // namespace mr

@@ -7,6 +7,8 @@
 #include <opencv2/imgcodecs.hpp>
 
 #include "util/error.h"
+#include "util/file.h"
+#include "util/testing.h"
 
 namespace mr {
 namespace {
@@ -184,6 +186,34 @@ TEST(ImageFile, TruncatedHeadersAreCorrupt) {
   EXPECT_NE(ErrorOf([&] { ReadImageHeader("t.tif", tif.substr(0, 6)); })
                 .find("t.tif: truncated or corrupt image (TIFF ends inside its header)"),
             std::string::npos);
+}
+
+// WriteImageFile writes in the format of the extension and round-trips: a PNG
+// exactly, a JPEG within its compression error (and smaller at a lower
+// quality); the folder is created; a format OpenCV cannot write is refused.
+TEST(ImageFile, WrittenImagesReadBack) {
+  const std::string dir = JoinPaths(MakeTestDir("write_image_file"), "sub");
+  cv::Mat image(40, 56, CV_8UC3);
+  for (int r = 0; r < image.rows; ++r) {
+    for (int c = 0; c < image.cols; ++c) {
+      image.at<cv::Vec3b>(r, c) = cv::Vec3b(4 * c, 6 * r, 2 * (r + c));  // smooth ramps
+    }
+  }
+  WriteImageFile(JoinPaths(dir, "a.png"), image);
+  const cv::Mat png = cv::imread(JoinPaths(dir, "a.png"), cv::IMREAD_UNCHANGED);
+  ASSERT_EQ(png.size(), image.size());
+  EXPECT_EQ(cv::norm(png, image, cv::NORM_INF), 0);
+  WriteImageFile(JoinPaths(dir, "b.jpg"), image, 95);
+  WriteImageFile(JoinPaths(dir, "c.jpg"), image, 30);
+  const std::string high = ReadFileToString(JoinPaths(dir, "b.jpg"));
+  ASSERT_GE(high.size(), 2u);
+  EXPECT_EQ(static_cast<unsigned char>(high[0]), 0xFF);
+  EXPECT_EQ(static_cast<unsigned char>(high[1]), 0xD8);
+  EXPECT_LT(ReadFileToString(JoinPaths(dir, "c.jpg")).size(), high.size());
+  const cv::Mat jpg = cv::imread(JoinPaths(dir, "b.jpg"), cv::IMREAD_COLOR);
+  ASSERT_EQ(jpg.size(), image.size());
+  EXPECT_LT(cv::norm(jpg, image, cv::NORM_L1) / (3.0 * image.total()), 8.0);
+  EXPECT_THROW(WriteImageFile(JoinPaths(dir, "d.unknownformat"), image), InputError);
 }
 
 }  // namespace

@@ -204,30 +204,6 @@ std::string UndistortionFingerprint(const std::string& image_dir, const std::str
   return s.str();
 }
 
-namespace {
-
-void WriteImageAtomically(const std::string& path, const cv::Mat& image, int jpeg_quality) {
-  CreateDirIfNotExists(GetParentDir(path));
-  std::vector<uchar> buffer;
-  std::string ext = GetExtension(path);
-  if (ext.empty()) ext = ".png";
-  std::vector<int> params;
-  if (ext == ".jpg" || ext == ".jpeg") params = {cv::IMWRITE_JPEG_QUALITY, jpeg_quality};
-  bool ok = false;
-  try {
-    ok = cv::imencode(ext, image, buffer, params);
-  } catch (const cv::Exception& e) {
-    ok = false;
-  }
-  if (!ok) MR_THROW_INPUT << path << ": cannot encode the undistorted image as '" << ext << "'";
-  WriteFileAtomically(path, [&](std::ostream& out) {
-    out.write(reinterpret_cast<const char*>(buffer.data()),
-              static_cast<std::streamsize>(buffer.size()));
-  });
-}
-
-}  // namespace
-
 UndistortionSummary UndistortSparseModel(const std::string& image_dir,
                                          const std::string& mask_dir,
                                          const Reconstruction& model,
@@ -290,7 +266,7 @@ UndistortionSummary UndistortSparseModel(const std::string& image_dir,
     }
     cv::Mat undistorted;
     cv::remap(in, undistorted, mx, my, cv::INTER_LINEAR, cv::BORDER_CONSTANT, cv::Scalar::all(0));
-    WriteImageAtomically(JoinPaths(out_images, image.name), undistorted, options.jpeg_quality);
+    WriteImageFile(JoinPaths(out_images, image.name), undistorted, options.jpeg_quality);
     ++summary.num_images;
 
     if (!mask_dir.empty()) {
@@ -304,7 +280,7 @@ UndistortionSummary UndistortSparseModel(const std::string& image_dir,
         cv::Mat out_mask;
         cv::remap(mask, out_mask, mx, my, cv::INTER_NEAREST, cv::BORDER_CONSTANT,
                   cv::Scalar::all(0));
-        WriteImageAtomically(JoinPaths(out_masks, image.name + ".png"), out_mask,
+        WriteImageFile(JoinPaths(out_masks, image.name + ".png"), out_mask,
                              options.jpeg_quality);
         ++summary.num_masks;
       }

@@ -7,9 +7,9 @@
 #include <vector>
 
 #include <opencv2/core.hpp>
-#include <opencv2/imgcodecs.hpp>
 
 #include "colmap_io/dense_array.h"
+#include "colmap_io/image_file.h"
 #include "colmap_io/mesh_io.h"
 #include "colmap_io/ply.h"
 #include "colmap_io/sparse_model.h"
@@ -21,23 +21,6 @@
 
 namespace mr {
 namespace {
-
-// Encodes `mat` (PNG, or JPEG of jpeg_quality 1-100) and writes it atomically.
-void WriteEncoded(const std::string& path, const cv::Mat& mat, int jpeg_quality = 0) {
-  std::vector<uchar> buffer;
-  const bool jpeg = jpeg_quality > 0;
-  const std::vector<int> params =
-      jpeg ? std::vector<int>{cv::IMWRITE_JPEG_QUALITY, jpeg_quality} : std::vector<int>{};
-  if (!cv::imencode(jpeg ? ".jpg" : ".png", mat, buffer, params)) {
-    MR_THROW_INPUT << path << ": " << (jpeg ? "JPEG" : "PNG") << " encoding failed";
-  }
-  WriteFileAtomically(path, [&](std::ostream& out) {
-    out.write(reinterpret_cast<const char*>(buffer.data()),
-              static_cast<std::streamsize>(buffer.size()));
-  });
-}
-
-void WritePng(const std::string& path, const cv::Mat& mat) { WriteEncoded(path, mat); }
 
 TriangleMesh LoadGroundTruth(const SynthesizerOptions& options) {
   TriangleMesh mesh;
@@ -172,7 +155,7 @@ void WriteSynthImage(const std::string& path, const SynthImage& image, int jpeg_
       mat.at<cv::Vec3b>(row, col) = cv::Vec3b(rgb[2], rgb[1], rgb[0]);  // OpenCV is BGR
     }
   }
-  WriteEncoded(path, mat, jpeg_quality);
+  WriteImageFile(path, mat, jpeg_quality);
 }
 
 SynthesizerSummary SynthesizeWorkspace(const SynthesizerOptions& options) {
@@ -255,7 +238,7 @@ SynthesizerSummary SynthesizeWorkspace(const SynthesizerOptions& options) {
               image.coverage[static_cast<size_t>(row) * image.width + col] >= 0.5f ? 255 : 0;
         }
       }
-      WritePng(JoinPaths(masks_dir, name + ".png"), mask);
+      WriteImageFile(JoinPaths(masks_dir, name + ".png"), mask);
     }
     double covered = 0;
     for (float c : image.coverage) covered += c;

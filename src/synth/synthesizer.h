@@ -114,7 +114,8 @@ SynthesizerSummary SynthesizeWorkspace(const SynthesizerOptions& options);
 std::string SynthViewName(int i, const std::string& extension = ".png");
 
 // Writes an 8-bit RGB image of `image` (radiance * 255, rounded; grey styles
-// give R = G = B): PNG for jpeg_quality 0, else JPEG of that quality (1-100).
-void WriteSynthImage(const std::string& path, const SynthImage& image, int jpeg_quality = 0);
+// give R = G = B) in the format of the path's extension (WriteImageFile):
+// PNG for ".png", JPEG of `jpeg_quality` (1-100) for ".jpg".
+void WriteSynthImage(const std::string& path, const SynthImage& image, int jpeg_quality = 95);
 
 }  // namespace mr
