@@ -202,6 +202,49 @@ SurfaceDisplacement MeasureSurfaceDisplacement(const Eigen::MatrixXd& V,
   return d;
 }
 
+VertexErrors MeasureVertexErrors(const Eigen::MatrixXd& V, const Eigen::MatrixXd& gt_V,
+                                 const Eigen::MatrixXi& gt_F,
+                                 const std::vector<char>* gt_observed) {
+  MR_CHECK(gt_F.rows() > 0) << "ground truth without faces";
+  MR_CHECK(gt_observed == nullptr || static_cast<Eigen::Index>(gt_observed->size()) == gt_F.rows())
+      << "observed flags: " << gt_observed->size() << " for " << gt_F.rows() << " faces";
+  VertexErrors errors;
+  errors.distance.resize(V.rows());
+  errors.observed.assign(V.rows(), 1);
+  const ClosestPointQuery tree(gt_V, gt_F);
+#ifdef _OPENMP
+#pragma omp parallel for schedule(dynamic, 1024)
+#endif
+  for (Eigen::Index v = 0; v < V.rows(); ++v) {
+    int face = -1;
+    errors.distance(v) = tree.Distance(V.row(v).transpose(), &face);
+    if (gt_observed != nullptr) errors.observed[v] = (*gt_observed)[face];
+  }
+  return errors;
+}
+
+Eigen::Matrix<uint8_t, Eigen::Dynamic, 3> ErrorColors(const VertexErrors& errors,
+                                                      double max_distance) {
+  MR_CHECK(max_distance > 0) << "max_distance " << max_distance;
+  // Five stops of the viridis scale (its values at 0, 1/4, 1/2, 3/4, 1).
+  static const double kStops[5][3] = {
+      {68, 1, 84}, {59, 82, 139}, {33, 145, 140}, {94, 201, 98}, {253, 231, 37}};
+  Eigen::Matrix<uint8_t, Eigen::Dynamic, 3> colors(errors.distance.size(), 3);
+  for (Eigen::Index v = 0; v < errors.distance.size(); ++v) {
+    if (!errors.observed[v]) {
+      colors.row(v).setConstant(128);
+      continue;
+    }
+    const double t = 4 * std::clamp(errors.distance(v) / max_distance, 0.0, 1.0);
+    const int k = std::min(3, static_cast<int>(t));
+    const double w = t - k;
+    for (int c = 0; c < 3; ++c) {
+      colors(v, c) = static_cast<uint8_t>(std::lround((1 - w) * kStops[k][c] + w * kStops[k + 1][c]));
+    }
+  }
+  return colors;
+}
+
 bool EvaluationOptions::Check() const {
   if (!(threshold > 0) || !std::isfinite(threshold)) {
     MR_THROW_INPUT << "EvaluationOptions::threshold = " << threshold

@@ -3,6 +3,7 @@
 // Mesh accuracy against a ground-truth mesh, Middlebury-style, using exact
 // point-to-triangle distances (CGAL AABB tree) on area-uniform samples.
 
+#include <cstdint>
 #include <memory>
 #include <string>
 #include <vector>
@@ -71,6 +72,23 @@ struct SurfaceDisplacement {
 SurfaceDisplacement MeasureSurfaceDisplacement(const Eigen::MatrixXd& V,
                                                const Eigen::MatrixXd& V0,
                                                const Eigen::MatrixXi& F0);
+
+// Where a mesh is wrong: the distance from each vertex of a mesh to the
+// ground truth (exact, as Distance), and whether its closest ground-truth face
+// is observed (every vertex is, without a mask).
+struct VertexErrors {
+  Eigen::VectorXd distance;
+  std::vector<char> observed;
+};
+VertexErrors MeasureVertexErrors(const Eigen::MatrixXd& V, const Eigen::MatrixXd& gt_V,
+                                 const Eigen::MatrixXi& gt_F,
+                                 const std::vector<char>* gt_observed = nullptr);
+
+// An error map's colours (RGB): the viridis scale from dark blue (0) through
+// green to yellow (`max_distance` and beyond); vertices whose closest
+// ground-truth face is not observed are mid grey. max_distance > 0.
+Eigen::Matrix<uint8_t, Eigen::Dynamic, 3> ErrorColors(const VertexErrors& errors,
+                                                      double max_distance);
 
 // Faces of (V, F) visible in at least `min_views` of `views`: the face's
 // centroid lies in the image and is not occluded (depth test against an EGL

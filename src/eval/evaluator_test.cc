@@ -6,6 +6,7 @@
 #include <map>
 #include <string>
 #include <utility>
+#include <vector>
 
 #include <Eigen/Geometry>
 #include <gtest/gtest.h>
@@ -181,6 +182,43 @@ TEST(MeasureSurfaceDisplacement, KnownDistances) {
   EXPECT_EQ(none.max, 0);
 }
 
+// The error map: each vertex's exact distance, and the colour scale's ends.
+TEST(MeasureVertexErrors, DistancesObservedFlagsAndColours) {
+  const Mesh plane = Plane(4);  // the unit square, 32 faces
+  Eigen::MatrixXd points(3, 3);
+  points << 0.3, 0.4, 0.1,  //
+      0.7, 0.2, -0.3,       //
+      1.3, 0.5, 0.4;        // beside the square: hypot(0.3, 0.4) = 0.5
+  VertexErrors errors = MeasureVertexErrors(points, plane.V, plane.F);
+  ASSERT_EQ(errors.distance.size(), 3);
+  EXPECT_NEAR(errors.distance(0), 0.1, 1e-12);
+  EXPECT_NEAR(errors.distance(1), 0.3, 1e-12);
+  EXPECT_NEAR(errors.distance(2), 0.5, 1e-12);
+  EXPECT_EQ(errors.observed, std::vector<char>(3, 1));
+  // Only the faces over x < 0.5 observed: the first point's closest face is.
+  std::vector<char> observed(plane.F.rows(), 0);
+  for (int f = 0; f < plane.F.rows(); ++f) {
+    double x = 0;
+    for (int k = 0; k < 3; ++k) x += plane.V(plane.F(f, k), 0) / 3;
+    observed[f] = x < 0.5;
+  }
+  errors = MeasureVertexErrors(points, plane.V, plane.F, &observed);
+  EXPECT_EQ(errors.observed, std::vector<char>({1, 0, 0}));
+  EXPECT_NEAR(errors.distance(1), 0.3, 1e-12);  // measured all the same
+
+  // Colours at 0, half way (viridis at 1/2) and beyond the maximum; grey where
+  // the closest ground truth is not observed.
+  errors.distance << 0.0, 0.25, 0.9;
+  errors.observed = {1, 1, 1};
+  auto colors = ErrorColors(errors, 0.5);
+  EXPECT_EQ(colors.row(0).cast<int>(), Eigen::RowVector3i(68, 1, 84));
+  EXPECT_EQ(colors.row(1).cast<int>(), Eigen::RowVector3i(33, 145, 140));
+  EXPECT_EQ(colors.row(2).cast<int>(), Eigen::RowVector3i(253, 231, 37));
+  errors.observed = {1, 0, 1};
+  colors = ErrorColors(errors, 0.5);
+  EXPECT_EQ(colors.row(1).cast<int>(), Eigen::RowVector3i(128, 128, 128));
+}
+
 TEST(EvaluateMesh, TranslatedPlane) {
   const Mesh plane = Plane(8);
   Eigen::MatrixXd moved = plane.V;
@@ -313,6 +351,36 @@ TEST(MeshEvaluator, CommandLine) {
   EXPECT_NE(json.find("\"accuracy90\": 0.25,"), std::string::npos) << json;
   EXPECT_NE(json.find("\"completeness\": 100.000000"), std::string::npos) << json;
   EXPECT_NE(json.find("\"faces\": 32}"), std::string::npos) << json;
+
+  // The error map: the evaluated mesh with each vertex's distance (0.25
+  // everywhere) as its value and colour; yellow at --error_max 0.25.
+  const std::string map_path = JoinPaths(dir, "map.ply");
+  const std::string with_map = base + " --gt_path '" + JoinPaths(dir, "gt.obj") +
+                               "' --num_samples 1000 --output_error_path '" + map_path +
+                               "' --error_max 0.25 > '" + out + "' 2> '" + err + "'";
+  ASSERT_EQ(std::system(with_map.c_str()), 0) << ReadFileToString(err);
+  const TriangleMesh map = ReadMesh(map_path);
+  ASSERT_EQ(map.NumVertices(), recon.NumVertices());
+  EXPECT_EQ(map.F, recon.F);
+  ASSERT_EQ(map.values.size(), recon.NumVertices());
+  ASSERT_EQ(map.C.rows(), recon.NumVertices());
+  for (int v = 0; v < map.NumVertices(); ++v) {
+    EXPECT_NEAR(map.values(v), 0.25, 1e-6);
+    EXPECT_EQ(map.C.row(v).cast<int>(), Eigen::RowVector3i(253, 231, 37));
+  }
+  // The map may not replace an input, and is a PLY.
+  const std::string gt_bytes = ReadFileToString(JoinPaths(dir, "gt.obj"));
+  for (const std::string& bad_map : {JoinPaths(dir, "gt.obj"), JoinPaths(dir, "map.obj")}) {
+    const std::string refused = base + " --gt_path '" + JoinPaths(dir, "gt.obj") +
+                                "' --output_error_path '" + bad_map + "' > '" + out + "' 2> '" +
+                                err + "'";
+    const int code = std::system(refused.c_str());
+    EXPECT_TRUE(WIFEXITED(code) && WEXITSTATUS(code) == 1);
+    EXPECT_NE(ReadFileToString(err).find("--output_error_path"), std::string::npos)
+        << ReadFileToString(err);
+  }
+  EXPECT_EQ(ReadFileToString(JoinPaths(dir, "gt.obj")), gt_bytes);
+  EXPECT_FALSE(ExistsFile(JoinPaths(dir, "map.obj")));
 
   // Missing file: one ERROR line, exit status 1.
   const std::string bad = base + " --gt_path '" + JoinPaths(dir, "nope.ply") + "' > '" + out +

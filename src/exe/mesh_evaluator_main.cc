@@ -16,6 +16,7 @@
 #include <Eigen/Geometry>
 
 #include "colmap_io/mesh_io.h"
+#include "colmap_io/ply.h"
 #include "colmap_io/sparse_model.h"
 #include "eval/evaluator.h"
 #include "util/error.h"
@@ -70,6 +71,16 @@ int main(int argc, char** argv) {
                 "with --sparse_path: first carry the mesh and the model's cameras into the true "
                 "world by the similarity that best aligns the cameras with the true ones (the "
                 "gauge an SfM model leaves free; alignment_* in the JSON)");
+    std::string output_error_path;
+    double error_max = 0;
+    manager.Add("output_error_path", &output_error_path,
+                "also write the evaluated mesh here (.ply) as an error map: each vertex's "
+                "distance to the ground truth as its `value` and as a colour (viridis, dark blue "
+                "0 to yellow at --error_max; mid grey where the closest ground truth is not "
+                "observed); after --align_cameras, in the true world");
+    manager.Add("error_max", &error_max,
+                "with --output_error_path: the distance drawn yellow, in scene units (> 0; 0 = "
+                "this mesh's accuracy90). Give two meshes the same value to compare their maps");
     manager.SetInputPaths([&] {
       mr::WorkspaceOptions ws_options;
       ws_options.use_masks = false;
@@ -101,6 +112,18 @@ int main(int argc, char** argv) {
     }
     if (align_cameras && sparse_path.empty()) {
       MR_THROW_INPUT << "--align_cameras needs --sparse_path and --true_sparse_path";
+    }
+    if (!output_error_path.empty()) {
+      mr::RefuseOutputOverInput("--output_error_path", output_error_path,
+                                {input_path, gt_path});
+      if (mr::GetExtension(output_error_path) != ".ply") {
+        MR_THROW_INPUT << "--output_error_path " << output_error_path
+                       << ": expected a .ply file (the map is stored as vertex colours and values)";
+      }
+      mr::CheckOutputFile("--output_error_path", output_error_path);
+      if (!(error_max >= 0) || !std::isfinite(error_max)) {
+        MR_THROW_INPUT << "--error_max " << error_max << ": expected >= 0 (0: the accuracy90)";
+      }
     }
     mr::TriangleMesh mesh = mr::ReadMesh(input_path);
     const mr::TriangleMesh gt = mr::ReadMesh(gt_path);
@@ -152,6 +175,19 @@ int main(int argc, char** argv) {
           << ", \"alignment_shift\": " << model_to_truth.translation.norm();
         json.insert(json.size() - 1, s.str());
       }
+    }
+    if (!output_error_path.empty()) {
+      const mr::VertexErrors errors = mr::MeasureVertexErrors(
+          mesh.V, gt.V, gt.F, observed.empty() ? nullptr : &observed);
+      const double max_distance = error_max > 0 ? error_max : result.accuracy90;
+      mr::TriangleMesh map;
+      map.V = mesh.V;
+      map.F = mesh.F;
+      map.values = errors.distance;
+      map.C = mr::ErrorColors(errors, max_distance > 0 ? max_distance : 1.0);
+      mr::WritePly(output_error_path, map);
+      MR_LOG(INFO) << "Wrote the error map " << output_error_path << " (" << map.NumVertices()
+                   << " vertices; yellow at " << max_distance << ")";
     }
     std::cout << json << std::endl;
     return 0;

@@ -78,6 +78,11 @@ int main(int argc, char** argv) {
     manager.Add("lighting", &options.lighting, "key or headlight");
     manager.Add("ambient", &options.ambient, "ambient term in [0, 1)");
     manager.Add("background", &options.background, "background grey level 0..255");
+    bool vertex_colors = false;
+    manager.Add("vertex_colors", &vertex_colors,
+                "shade front faces in the meshes' vertex colours (e.g. mesh_evaluator's "
+                "--output_error_path map, or a COLMAP mesh's colours) instead of grey; a mesh "
+                "without colours is refused");
     manager.SetInputPaths([&] {
       mr::WorkspaceOptions ws_options;
       ws_options.use_masks = false;
@@ -175,9 +180,21 @@ int main(int argc, char** argv) {
     } catch (const mr::InputError& e) {
       MR_LOG(WARNING) << "No EGL renderer (" << e.what() << "); using the slow CPU renderer";
     }
-    cv::Mat picture = mr::RenderMeshPicture(renderer.get(), mesh.V, mesh.F, view, options);
+    auto colors_of = [&](const mr::TriangleMesh& m, const std::string& path) {
+      if (!vertex_colors) return static_cast<const mr::VertexColors*>(nullptr);
+      if (m.C.rows() != m.V.rows()) {
+        MR_THROW_INPUT << path << ": --vertex_colors 1 but the mesh has no vertex colours";
+      }
+      return &m.C;
+    };
+    const mr::VertexColors* colors = colors_of(mesh, input_path);
+    const mr::VertexColors* second_colors =
+        second.NumFaces() > 0 ? colors_of(second, side_by_side) : nullptr;
+    cv::Mat picture =
+        mr::RenderMeshPicture(renderer.get(), mesh.V, mesh.F, view, options, colors);
     if (second.NumFaces() > 0) {
-      const cv::Mat right = mr::RenderMeshPicture(renderer.get(), second.V, second.F, view, options);
+      const cv::Mat right = mr::RenderMeshPicture(renderer.get(), second.V, second.F, view,
+                                                  options, second_colors);
       cv::hconcat(picture, right, picture);
     }
     mr::WritePng(output_path, picture);

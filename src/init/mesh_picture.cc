@@ -72,10 +72,14 @@ PinholeView OrbitView(const Eigen::AlignedBox3d& bounds, double azimuth_deg,
 }
 
 cv::Mat ShadeBuffers(const RenderBuffers& buffers, const Eigen::MatrixXd& face_normals,
-                     const PinholeView& view, const MeshPictureOptions& options) {
+                     const PinholeView& view, const MeshPictureOptions& options,
+                     const Eigen::MatrixXi* F, const VertexColors* colors) {
   MR_CHECK(buffers.width == view.width && buffers.height == view.height)
       << "buffers " << buffers.width << "x" << buffers.height << ", view " << view.width << "x"
       << view.height;
+  MR_CHECK((F == nullptr) == (colors == nullptr)) << "colours need the faces that index them";
+  MR_CHECK(F == nullptr || F->rows() == face_normals.rows())
+      << F->rows() << " faces, " << face_normals.rows() << " normals";
   const Eigen::Vector3d key_cam = Eigen::Vector3d(-0.4, -0.6, -1.0).normalized();
   const Eigen::Vector3d key = view.R.transpose() * key_cam;
   const uchar bg = static_cast<uchar>(options.background);
@@ -93,9 +97,17 @@ cv::Mat ShadeBuffers(const RenderBuffers& buffers, const Eigen::MatrixXd& face_n
       const Eigen::Vector3d light = options.lighting == "headlight" ? to_eye : key;
       const double lambert = std::max(0.0, ns.dot(light));
       const double intensity = options.ambient + (1 - options.ambient) * lambert;
-      // Grey for front faces, red (BGR) for back faces.
-      const Eigen::Vector3d albedo =
+      // Grey (or the vertex colours) for front faces, red (BGR) for back faces.
+      Eigen::Vector3d albedo =
           back ? Eigen::Vector3d(70, 70, 230) : Eigen::Vector3d(225, 225, 225);
+      if (!back && colors != nullptr) {
+        const size_t pixel = static_cast<size_t>(row) * view.width + col;
+        const double u = buffers.bary[2 * pixel], v = buffers.bary[2 * pixel + 1];
+        const Eigen::Vector3d rgb = (1 - u - v) * colors->row((*F)(f, 0)).cast<double>() +
+                                    u * colors->row((*F)(f, 1)).cast<double>() +
+                                    v * colors->row((*F)(f, 2)).cast<double>();
+        albedo = rgb.reverse();  // BGR
+      }
       for (int c = 0; c < 3; ++c) {
         out[col][c] = static_cast<uchar>(std::clamp(albedo(c) * intensity, 1.0, 255.0));
       }
@@ -105,8 +117,13 @@ cv::Mat ShadeBuffers(const RenderBuffers& buffers, const Eigen::MatrixXd& face_n
 }
 
 cv::Mat RenderMeshPicture(Renderer* renderer, const Eigen::MatrixXd& V, const Eigen::MatrixXi& F,
-                          const PinholeView& view, const MeshPictureOptions& options) {
+                          const PinholeView& view, const MeshPictureOptions& options,
+                          const VertexColors* colors) {
   options.Check();
+  if (colors != nullptr && colors->rows() != V.rows()) {
+    MR_THROW_INPUT << "RenderMeshPicture: " << colors->rows() << " vertex colours for "
+                   << V.rows() << " vertices";
+  }
   const PinholeView big = options.supersample == 1 ? view : view.Scaled(options.supersample);
   RenderBuffers buffers;
   if (renderer != nullptr) {
@@ -115,7 +132,8 @@ cv::Mat RenderMeshPicture(Renderer* renderer, const Eigen::MatrixXd& V, const Ei
   } else {
     buffers = RenderCpu(V, F, big);
   }
-  cv::Mat image = ShadeBuffers(buffers, FaceNormals(V, F), big, options);
+  cv::Mat image = ShadeBuffers(buffers, FaceNormals(V, F), big, options,
+                               colors != nullptr ? &F : nullptr, colors);
   if (options.supersample > 1) {
     cv::resize(image, image, cv::Size(view.width, view.height), 0, 0, cv::INTER_AREA);
   }

@@ -5,6 +5,7 @@
 // and shaded on the CPU. Back faces (seen from behind: wrong orientation or
 // holes) are tinted red so that they stand out.
 
+#include <cstdint>
 #include <string>
 
 #include <Eigen/Core>
@@ -36,13 +37,22 @@ PinholeView OrbitView(const Eigen::AlignedBox3d& bounds, double azimuth_deg,
                       double elevation_deg, int width, int height, const Eigen::Vector3d& up,
                       const Eigen::Vector3d& front);
 
-// Shades rendered buffers: 8-bit BGR image of the view's size.
-cv::Mat ShadeBuffers(const RenderBuffers& buffers, const Eigen::MatrixXd& face_normals,
-                     const PinholeView& view, const MeshPictureOptions& options);
+// Per-vertex RGB colours (as TriangleMesh::C).
+using VertexColors = Eigen::Matrix<uint8_t, Eigen::Dynamic, 3>;
 
-// Renders and shades a mesh (through `renderer`, or RenderCpu if null).
+// Shades rendered buffers: 8-bit BGR image of the view's size. Front faces
+// are grey, or with `colors` (and the faces F they index) take the colour
+// interpolated at each pixel's surface point (an error map, a COLMAP mesh's
+// colours); back faces stay red.
+cv::Mat ShadeBuffers(const RenderBuffers& buffers, const Eigen::MatrixXd& face_normals,
+                     const PinholeView& view, const MeshPictureOptions& options,
+                     const Eigen::MatrixXi* F = nullptr, const VertexColors* colors = nullptr);
+
+// Renders and shades a mesh (through `renderer`, or RenderCpu if null), in
+// `colors` if given (one row per vertex of V).
 cv::Mat RenderMeshPicture(Renderer* renderer, const Eigen::MatrixXd& V, const Eigen::MatrixXi& F,
-                          const PinholeView& view, const MeshPictureOptions& options);
+                          const PinholeView& view, const MeshPictureOptions& options,
+                          const VertexColors* colors = nullptr);
 
 // Writes an image as PNG, atomically. Throws InputError if it cannot.
 void WritePng(const std::string& path, const cv::Mat& image);

@@ -100,6 +100,41 @@ TEST(RenderMeshPicture, ObjectPixelsAreShaded) {
   EXPECT_GT(red[2], red[0] + 50);
 }
 
+// Vertex colours replace the grey on front faces, shaded the same way: a
+// sphere coloured pure green renders green, with the grey picture's shading.
+TEST(RenderMeshPicture, VertexColoursAreShaded) {
+  Eigen::MatrixXd V;
+  Eigen::MatrixXi F;
+  Sphere(&V, &F);
+  std::unique_ptr<Renderer> renderer = MakeRenderer();
+  const Eigen::AlignedBox3d box(V.colwise().minCoeff().transpose(),
+                                V.colwise().maxCoeff().transpose());
+  const PinholeView view = OrbitView(box, 30, 20, 64, 48, Eigen::Vector3d::UnitY(),
+                                     Eigen::Vector3d::UnitZ());
+  MeshPictureOptions options;
+  options.background = 0;
+  VertexColors green(V.rows(), 3);
+  green.setZero();
+  green.col(1).setConstant(225);  // the grey's own level, in green only
+  const cv::Mat grey = RenderMeshPicture(renderer.get(), V, F, view, options);
+  const cv::Mat image = RenderMeshPicture(renderer.get(), V, F, view, options, &green);
+  const cv::Vec3b centre = image.at<cv::Vec3b>(24, 32);  // BGR
+  EXPECT_GT(centre[1], 30);
+  EXPECT_LE(centre[0], 1);
+  EXPECT_LE(centre[2], 1);
+  EXPECT_EQ(centre[1], grey.at<cv::Vec3b>(24, 32)[1]);
+  EXPECT_EQ(image.at<cv::Vec3b>(0, 0), cv::Vec3b(0, 0, 0));
+  // Back faces stay red whatever the colours.
+  Eigen::MatrixXi flipped = F;
+  flipped.col(1).swap(flipped.col(2));
+  const cv::Vec3b red =
+      RenderMeshPicture(renderer.get(), V, flipped, view, options, &green).at<cv::Vec3b>(24, 32);
+  EXPECT_GT(red[2], red[1] + 50);
+  VertexColors too_few(3, 3);
+  too_few.setZero();
+  EXPECT_THROW(RenderMeshPicture(renderer.get(), V, F, view, options, &too_few), InputError);
+}
+
 TEST(MeshRender, ProgramWritesAPng) {
   const std::string exe = JoinPaths(MR_BIN_DIR, "mesh_render");
   ASSERT_TRUE(ExistsFile(exe)) << exe << " is not built";
@@ -124,6 +159,26 @@ TEST(MeshRender, ProgramWritesAPng) {
                            " 2> " + JoinPaths(dir, "log.txt");
   ASSERT_EQ(std::system(cmd2.c_str()), 0) << ReadFileToString(JoinPaths(dir, "log.txt"));
   EXPECT_EQ(cv::imread(out, cv::IMREAD_COLOR).cols, 120);
+  // --vertex_colors: the mesh's colours; a mesh without them is refused.
+  TriangleMesh coloured = mesh;
+  coloured.C.resize(mesh.NumVertices(), 3);
+  coloured.C.setZero();
+  coloured.C.col(0).setConstant(200);  // red
+  WritePly(JoinPaths(dir, "red.ply"), coloured);
+  const std::string cmd4 = exe + " --input_path " + JoinPaths(dir, "red.ply") +
+                           " --vertex_colors 1 --view \"20 10\" --width 60 --height 40 "
+                           "--background 0 --output_path " + out + " 2> " +
+                           JoinPaths(dir, "log.txt");
+  ASSERT_EQ(std::system(cmd4.c_str()), 0) << ReadFileToString(JoinPaths(dir, "log.txt"));
+  const cv::Vec3b red = cv::imread(out, cv::IMREAD_COLOR).at<cv::Vec3b>(20, 30);
+  EXPECT_GT(red[2], 30);
+  EXPECT_LE(red[1], 1);
+  const std::string cmd5 = exe + " --input_path " + JoinPaths(dir, "sphere.ply") +
+                           " --vertex_colors 1 --view \"20 10\" --output_path " + out + " 2> " +
+                           JoinPaths(dir, "log.txt");
+  EXPECT_NE(std::system(cmd5.c_str()), 0);
+  EXPECT_NE(ReadFileToString(JoinPaths(dir, "log.txt")).find("no vertex colours"),
+            std::string::npos);
   // A missing mesh fails with a message.
   const std::string cmd3 = exe + " --input_path " + JoinPaths(dir, "missing.ply") +
                            " --view \"0 0\" --output_path " + out + " 2> " +
