@@ -588,6 +588,9 @@ bool RefineOptions::Check() const {
     fail("regularizer", regularizer, "one of lp, laplacian, bilateral_normal, none");
   }
   if (!(silhouette_weight >= 0)) fail("silhouette_weight", std::to_string(silhouette_weight), "silhouette_weight >= 0");
+  if (!std::isfinite(hull_margin_px)) {
+    fail("hull_margin_px", std::to_string(hull_margin_px), "a finite number (< 0: off)");
+  }
   if (light != "world" && light != "headlight" && light != "auto") {
     fail("light", light, "one of world, headlight, auto");
   }
@@ -920,7 +923,7 @@ RefineSummary RefineMesh(const ViewSource& input_source, const RefineOptions& op
         const cv::Mat mask = images.Mask(i, level);
         if (!mask.empty()) {
           AccumulateSilhouetteTerm(V, F, N, views[i], render, mask, 3.0 * options.max_step_px,
-                                   &silhouette, &silhouette_count);
+                                   options.hull_margin_px, &silhouette, &silhouette_count);
         }
         silhouette_seconds += ElapsedSeconds() - t0;
       };
@@ -1232,6 +1235,9 @@ void RegisterRefineOptions(OptionManager* o, RefineOptions* r) {
          "lp proximal step: noise estimated from what the gradient step added, not the surface");
   o->Add("Refine.silhouette_weight", &r->silhouette_weight,
          "weight of the silhouette term when masks exist (>= 0)");
+  o->Add("Refine.hull_margin_px", &r->hull_margin_px,
+         "with the silhouette term: pull back every vertex that projects more than this many "
+         "pixels outside a mask (the visual hull); < 0: only contour vertices");
   o->Add("Refine.masks_from_background", &r->masks_from_background,
          "without masks, make them from a uniform background where they agree with the input "
          "mesh (for the silhouette term)");

@@ -648,7 +648,8 @@ TEST_F(RefinerTest, SilhouetteTermFollowsTheGapBetweenOutlines) {
     Eigen::MatrixXd d = Eigen::MatrixXd::Zero(V.rows(), 3);
     Eigen::VectorXd count = Eigen::VectorXd::Zero(V.rows());
     AccumulateSilhouetteTerm(V, F, N, view, render,
-                             RenderedCoverage(larger ? big_render : render), 3.0, &d, &count);
+                             RenderedCoverage(larger ? big_render : render), 3.0,
+                             /*hull_margin_px=*/-1, &d, &count);
     double radial_sum = 0;
     int contour = 0;
     for (int v = 0; v < V.rows(); ++v) {
@@ -667,6 +668,81 @@ TEST_F(RefinerTest, SilhouetteTermFollowsTheGapBetweenOutlines) {
     } else {
       EXPECT_NEAR(mean_px, 0.0, 0.15);
     }
+  }
+}
+
+// The visual hull: with a mask smaller than the mesh (a sphere 10 % smaller,
+// its outline about 8 px inside), every vertex off the contour that projects
+// outside the mask is pulled toward it across the image plane, by its
+// distance beyond the mask's edge, at most max_px; with the mesh's own mask
+// nothing off the contour moves by more than the pixel grid allows.
+TEST_F(RefinerTest, HullPullRetractsWhatLiesOutsideTheMask) {
+  Eigen::MatrixXd V;
+  Eigen::MatrixXi F;
+  MakeIcosphere(5, 1.0, &V, &F);
+  std::mt19937 rng(7);
+  std::normal_distribution<double> noise(0.0, 0.005);
+  for (int v = 0; v < V.rows(); ++v) V.row(v) *= 1.0 + noise(rng);
+  PinholeView view;
+  view.width = 320;
+  view.height = 240;
+  view.fx = view.fy = 400;
+  view.cx = 160;
+  view.cy = 120;
+  view.t = Eigen::Vector3d(0, 0, 5);
+  renderer_->SetMesh(V, F);
+  const RenderBuffers render = renderer_->Render(view);
+  const cv::Mat own_mask = RenderedCoverage(render);
+  renderer_->SetMesh(0.9 * V, F);
+  const cv::Mat small_mask = RenderedCoverage(renderer_->Render(view));
+  const Eigen::MatrixXd N = VertexNormals(V, F);
+  // Off the contour: no face of the vertex turns its back on the camera, or
+  // none faces it.
+  std::vector<char> front(V.rows(), 0), back(V.rows(), 0);
+  for (int f = 0; f < F.rows(); ++f) {
+    const Eigen::Vector3d a = V.row(F(f, 0)), b = V.row(F(f, 1)), c = V.row(F(f, 2));
+    const bool faces = (b - a).cross(c - a).dot(view.Center() - a) > 0;
+    for (int k = 0; k < 3; ++k) (faces ? front : back)[F(f, k)] = 1;
+  }
+  const double margin = 0, max_px = 3.0;
+  for (const bool small : {false, true}) {
+    Eigen::MatrixXd d = Eigen::MatrixXd::Zero(V.rows(), 3);
+    Eigen::VectorXd count = Eigen::VectorXd::Zero(V.rows());
+    AccumulateSilhouetteTerm(V, F, N, view, render, small ? small_mask : own_mask, max_px, margin,
+                             &d, &count);
+    int pulled = 0, capped = 0;
+    double largest_px = 0;
+    for (int v = 0; v < V.rows(); ++v) {
+      if ((front[v] && back[v]) || count(v) == 0) continue;
+      ++pulled;
+      const Eigen::Vector3d x = V.row(v);
+      const double footprint = view.WorldToCamera(x).z() / view.fx;
+      const double px = d.row(v).norm() / footprint;
+      largest_px = std::max(largest_px, px);
+      if (px > max_px - 1e-6) ++capped;
+      EXPECT_LE(px, max_px + 1e-6);
+      // Across the image plane (the view looks along +z) and, from well
+      // outside, toward the image centre (near the edge the nearest inside
+      // pixel may lie to the side).
+      EXPECT_NEAR(d(v, 2), 0, 1e-9 * d.row(v).norm()) << v;
+      if (px > 1) EXPECT_LT(d(v, 0) * x.x() + d(v, 1) * x.y(), 0) << v;
+    }
+    std::printf("%s mask: %d vertices off the contour pulled, %d by the full %.0f px; largest "
+                "%.3f px\n", small ? "smaller sphere's" : "own", pulled, capped, max_px,
+                largest_px);
+    if (small) {
+      EXPECT_GT(pulled, 200);
+      EXPECT_GT(capped, 100);  // most of the 8-px band
+    } else {
+      EXPECT_LT(largest_px, 0.75);  // the pixel grid's share only (<= sqrt(2)/2)
+    }
+  }
+  // A negative margin: only the contour term (the test above).
+  Eigen::MatrixXd d = Eigen::MatrixXd::Zero(V.rows(), 3);
+  Eigen::VectorXd count = Eigen::VectorXd::Zero(V.rows());
+  AccumulateSilhouetteTerm(V, F, N, view, render, small_mask, max_px, -1, &d, &count);
+  for (int v = 0; v < V.rows(); ++v) {
+    if (!(front[v] && back[v])) EXPECT_EQ(count(v), 0) << v;
   }
 }
 

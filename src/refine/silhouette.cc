@@ -11,6 +11,10 @@ namespace mr {
 
 namespace {
 
+// How far (pixels) the visual-hull pull looks for the mask from a vertex
+// outside it.
+constexpr int kHullSearchRadius = 32;
+
 // Signed distance (pixels, > 0 inside) from pixel (row, col) to the boundary
 // of the pixel set `inside`, the distance between pixel centres to the
 // nearest pixel of the other set less half a pixel, searched only up to
@@ -56,6 +60,30 @@ double SignedDistanceNear(const Inside& inside, int rows, int cols, double x, do
   return top + fv * (bottom - top);
 }
 
+// The offset (rows, cols) from pixel (row, col) to the nearest pixel of
+// `inside`, searched up to `radius` pixels away in rings of growing
+// Chebyshev distance, as above; false if none lies within.
+template <typename Inside>
+bool NearestInside(const Inside& inside, int rows, int cols, int row, int col, int radius,
+                   int* d_row, int* d_col) {
+  int best = radius * radius + 1;
+  for (int k = 1; k <= radius && k * k < best; ++k) {
+    for (int dr = -k; dr <= k; ++dr) {
+      const int r = row + dr;
+      if (r < 0 || r >= rows) continue;
+      const int step = (dr == -k || dr == k) ? 1 : 2 * k;  // the ring only
+      for (int dc = -k; dc <= k; dc += step) {
+        const int c = col + dc;
+        if (c < 0 || c >= cols || !inside(r, c) || dr * dr + dc * dc >= best) continue;
+        best = dr * dr + dc * dc;
+        *d_row = dr;
+        *d_col = dc;
+      }
+    }
+  }
+  return best <= radius * radius;
+}
+
 }  // namespace
 
 double SignedDistanceToMaskAt(const cv::Mat& mask, double x, double y, int radius) {
@@ -67,7 +95,8 @@ double SignedDistanceToMaskAt(const cv::Mat& mask, double x, double y, int radiu
 void AccumulateSilhouetteTerm(const Eigen::MatrixXd& V, const Eigen::MatrixXi& F,
                               const Eigen::MatrixXd& vertex_normals, const PinholeView& view,
                               const RenderBuffers& render, const cv::Mat& mask, double max_px,
-                              Eigen::MatrixXd* displacement, Eigen::VectorXd* count) {
+                              double hull_margin_px, Eigen::MatrixXd* displacement,
+                              Eigen::VectorXd* count) {
   MR_CHECK(mask.type() == CV_8U && mask.cols == view.width && mask.rows == view.height);
   MR_CHECK(render.width == view.width && render.height == view.height);
   // The rendered silhouette's own signed distance: a contour vertex of a
@@ -92,14 +121,37 @@ void AccumulateSilhouetteTerm(const Eigen::MatrixXd& V, const Eigen::MatrixXi& F
     const double s = (b - a).cross(c - a).dot(center - a);
     for (int k = 0; k < 3; ++k) (s > 0 ? front : back)[F(f, k)] = 1;
   }
+  const bool hull = hull_margin_px >= 0;
   for (int v = 0; v < V.rows(); ++v) {
-    if (!front[v] || !back[v]) continue;
+    const bool contour = front[v] && back[v];
+    if (!contour && !hull) continue;
     const Eigen::Vector3d x = V.row(v);
     const Eigen::Vector3d xc = view.WorldToCamera(x);
     if (xc.z() <= 0) continue;
     const Eigen::Vector2d p = view.CameraToImage(xc);
     const int col = static_cast<int>(std::floor(p.x())), row = static_cast<int>(std::floor(p.y()));
     if (col < 1 || row < 1 || col >= view.width - 1 || row >= view.height - 1) continue;
+    const double footprint = xc.z() / view.fx;
+    if (!contour) {
+      // The visual hull: toward the nearest mask pixel's centre, at the
+      // vertex's depth.
+      if (observed(row, col)) continue;
+      int dr = 0, dc = 0;
+      if (!NearestInside(observed, view.height, view.width, row, col, kHullSearchRadius, &dr,
+                         &dc)) {
+        continue;
+      }
+      // Its distance to the mask's edge: to the nearest inside pixel's centre
+      // less half a pixel, as SignedDistanceNear measures.
+      const Eigen::Vector2d target(col + dc + 0.5, row + dr + 0.5);
+      const double beyond = (target - p).norm() - 0.5 - hull_margin_px;
+      if (!(beyond > 0)) continue;
+      const Eigen::Vector3d direction =
+          (center + xc.z() * view.RayDirection(target.x(), target.y()) - x).normalized();
+      displacement->row(v) += (std::min(beyond, max_px) * footprint) * direction.transpose();
+      (*count)(v) += 1;
+      continue;
+    }
     // Only contour points on the rendered outline (background next to them)
     // are horizons; the others are hidden behind the object.
     bool on_outline = false;
@@ -122,7 +174,6 @@ void AccumulateSilhouetteTerm(const Eigen::MatrixXd& V, const Eigen::MatrixXi& F
         SignedDistanceNear(observed, view.height, view.width, p.x(), p.y(), radius) -
             SignedDistanceNear(rendered, view.height, view.width, p.x(), p.y(), radius),
         -max_px, max_px);
-    const double footprint = xc.z() / view.fx;
     displacement->row(v) += (s * footprint) * u.transpose();
     (*count)(v) += 1;
   }

@@ -31,10 +31,21 @@ double SignedDistanceToMaskAt(const cv::Mat& mask, double x, double y, int radiu
 // units) to `displacement` (#V by 3) and 1 to `count` (#V). `mask` is the
 // view's observed silhouette (CV_8U, inside where > 0). Distances are capped
 // at `max_px` pixels.
+//
+// With hull_margin_px >= 0, the same for every other vertex in front of the
+// view that projects more than hull_margin_px pixels beyond the mask's edge:
+// no point of the surface lies outside a silhouette (the visual hull), so
+// such a vertex (an open border's flap, or what Poisson extrapolated where
+// no image looked) is pulled across the image plane toward the nearest mask
+// pixel, by its distance beyond the margin (at most max_px). The edge is
+// half a pixel short of the nearest inside pixel's centre; since a mask
+// pixel is inside when its centre is, a point of the surface itself can lie
+// up to sqrt(2)/2 px beyond it. Vertices more than 32 px outside are left
+// to the next iterations.
 void AccumulateSilhouetteTerm(const Eigen::MatrixXd& V, const Eigen::MatrixXi& F,
                               const Eigen::MatrixXd& vertex_normals, const PinholeView& view,
-                              const RenderBuffers& render, const cv::Mat& signed_distance,
-                              double max_px, Eigen::MatrixXd* displacement,
+                              const RenderBuffers& render, const cv::Mat& mask, double max_px,
+                              double hull_margin_px, Eigen::MatrixXd* displacement,
                               Eigen::VectorXd* count);
 
 }  // namespace mr
