@@ -15,18 +15,16 @@ namespace {
 // outside it.
 constexpr int kHullSearchRadius = 32;
 
-// Signed distance (pixels, > 0 inside) from pixel (row, col) to the boundary
-// of the pixel set `inside`, the distance between pixel centres to the
-// nearest pixel of the other set less half a pixel, searched only up to
-// `radius` pixels away: where none lies within, the distance is reported as
-// radius + 1 (the true one is larger than radius; callers choose a radius
-// beyond the distances they use). The rings of pixels at growing
-// Chebyshev distance k are searched until k^2 reaches the best squared
-// distance found, so a pixel near the boundary costs a few dozen tests.
+// The nearest pixel to (row, col) whose `inside` value is `want`, searched
+// only up to `radius` pixels away: the rings of pixels at growing Chebyshev
+// distance k are searched until k^2 reaches the best squared distance found,
+// so a pixel near the boundary costs a few dozen tests. Returns the squared
+// distance (radius^2 + 1 where none lies within) and its offset in
+// (*d_row, *d_col).
 template <typename Inside>
-float SignedDistanceNear(const Inside& inside, int rows, int cols, int row, int col, int radius) {
-  const bool in = inside(row, col);
-  int best = radius * radius + 1;  // squared distance; > radius^2: none found
+int NearestWithValue(const Inside& inside, bool want, int rows, int cols, int row, int col,
+                     int radius, int* d_row, int* d_col) {
+  int best = radius * radius + 1;
   for (int k = 1; k <= radius && k * k < best; ++k) {
     for (int dr = -k; dr <= k; ++dr) {
       const int r = row + dr;
@@ -34,11 +32,27 @@ float SignedDistanceNear(const Inside& inside, int rows, int cols, int row, int 
       const int step = (dr == -k || dr == k) ? 1 : 2 * k;  // the ring only
       for (int dc = -k; dc <= k; dc += step) {
         const int c = col + dc;
-        if (c < 0 || c >= cols || inside(r, c) == in) continue;
-        best = std::min(best, dr * dr + dc * dc);
+        if (c < 0 || c >= cols || inside(r, c) != want || dr * dr + dc * dc >= best) continue;
+        best = dr * dr + dc * dc;
+        *d_row = dr;
+        *d_col = dc;
       }
     }
   }
+  return best;
+}
+
+// Signed distance (pixels, > 0 inside) from pixel (row, col) to the boundary
+// of the pixel set `inside`, the distance between pixel centres to the
+// nearest pixel of the other set less half a pixel, searched only up to
+// `radius` pixels away: where none lies within, the distance is reported as
+// radius + 1 (the true one is larger than radius; callers choose a radius
+// beyond the distances they use).
+template <typename Inside>
+float SignedDistanceNear(const Inside& inside, int rows, int cols, int row, int col, int radius) {
+  const bool in = inside(row, col);
+  int d_row = 0, d_col = 0;
+  const int best = NearestWithValue(inside, !in, rows, cols, row, col, radius, &d_row, &d_col);
   const float d = best > radius * radius ? radius + 1.0f : std::sqrt(static_cast<float>(best));
   return in ? d - 0.5f : 0.5f - d;
 }
@@ -58,30 +72,6 @@ double SignedDistanceNear(const Inside& inside, int rows, int cols, double x, do
                p11 = at(r0 + 1, c0 + 1);
   const double top = p00 + fu * (p01 - p00), bottom = p10 + fu * (p11 - p10);
   return top + fv * (bottom - top);
-}
-
-// The offset (rows, cols) from pixel (row, col) to the nearest pixel of
-// `inside`, searched up to `radius` pixels away in rings of growing
-// Chebyshev distance, as above; false if none lies within.
-template <typename Inside>
-bool NearestInside(const Inside& inside, int rows, int cols, int row, int col, int radius,
-                   int* d_row, int* d_col) {
-  int best = radius * radius + 1;
-  for (int k = 1; k <= radius && k * k < best; ++k) {
-    for (int dr = -k; dr <= k; ++dr) {
-      const int r = row + dr;
-      if (r < 0 || r >= rows) continue;
-      const int step = (dr == -k || dr == k) ? 1 : 2 * k;  // the ring only
-      for (int dc = -k; dc <= k; dc += step) {
-        const int c = col + dc;
-        if (c < 0 || c >= cols || !inside(r, c) || dr * dr + dc * dc >= best) continue;
-        best = dr * dr + dc * dc;
-        *d_row = dr;
-        *d_col = dc;
-      }
-    }
-  }
-  return best <= radius * radius;
 }
 
 }  // namespace
@@ -137,8 +127,8 @@ void AccumulateSilhouetteTerm(const Eigen::MatrixXd& V, const Eigen::MatrixXi& F
       // vertex's depth.
       if (observed(row, col)) continue;
       int dr = 0, dc = 0;
-      if (!NearestInside(observed, view.height, view.width, row, col, kHullSearchRadius, &dr,
-                         &dc)) {
+      if (NearestWithValue(observed, true, view.height, view.width, row, col, kHullSearchRadius,
+                           &dr, &dc) > kHullSearchRadius * kHullSearchRadius) {
         continue;
       }
       // Its distance to the mask's edge: to the nearest inside pixel's centre
