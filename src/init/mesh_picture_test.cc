@@ -71,15 +71,19 @@ TEST(OrbitView, FramesTheBox) {
   EXPECT_LT(v.Project(box.center() + 0.1 * Eigen::Vector3d::UnitZ()).y(), 30);
 }
 
+// A 64x48 view of the mesh, from azimuth 30 and elevation 20 degrees.
+PinholeView SmallOrbitView(const Eigen::MatrixXd& V) {
+  const Eigen::AlignedBox3d box(V.colwise().minCoeff().transpose(),
+                                V.colwise().maxCoeff().transpose());
+  return OrbitView(box, 30, 20, 64, 48, Eigen::Vector3d::UnitY(), Eigen::Vector3d::UnitZ());
+}
+
 TEST(RenderMeshPicture, ObjectPixelsAreShaded) {
   Eigen::MatrixXd V;
   Eigen::MatrixXi F;
   Sphere(&V, &F);
   std::unique_ptr<Renderer> renderer = MakeRenderer();
-  const Eigen::AlignedBox3d box(V.colwise().minCoeff().transpose(),
-                                V.colwise().maxCoeff().transpose());
-  const PinholeView view = OrbitView(box, 30, 20, 64, 48, Eigen::Vector3d::UnitY(),
-                                     Eigen::Vector3d::UnitZ());
+  const PinholeView view = SmallOrbitView(V);
   MeshPictureOptions options;
   options.background = 0;
   const cv::Mat image = RenderMeshPicture(renderer.get(), V, F, view, options);
@@ -107,10 +111,7 @@ TEST(RenderMeshPicture, VertexColoursAreShaded) {
   Eigen::MatrixXi F;
   Sphere(&V, &F);
   std::unique_ptr<Renderer> renderer = MakeRenderer();
-  const Eigen::AlignedBox3d box(V.colwise().minCoeff().transpose(),
-                                V.colwise().maxCoeff().transpose());
-  const PinholeView view = OrbitView(box, 30, 20, 64, 48, Eigen::Vector3d::UnitY(),
-                                     Eigen::Vector3d::UnitZ());
+  const PinholeView view = SmallOrbitView(V);
   MeshPictureOptions options;
   options.background = 0;
   VertexColors green(V.rows(), 3);

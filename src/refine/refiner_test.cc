@@ -621,23 +621,29 @@ TEST(ResizedViewSource, ImagesAndCamerasScaleTogether) {
 // was pushed outward, and textureless scenes inflated, accuracy90 1.39x the
 // input on the corpus's builtin-shading-40), and outward by the gap where
 // the mask comes from a larger sphere.
-TEST_F(RefinerTest, SilhouetteTermFollowsTheGapBetweenOutlines) {
-  Eigen::MatrixXd V, big_V;
-  Eigen::MatrixXi F;
-  // A fine, slightly rough sphere (edges ~1.5 px, radial noise 0.4 px): its
-  // contour generator is jagged, as a real mesh's is.
-  MakeIcosphere(5, 1.0, &V, &F);
+// A fine, slightly rough unit sphere (edges ~1.5 px, radial noise 0.4 px)
+// seen from 5 units by a 320x240 view: its contour generator is jagged, as a
+// real mesh's is.
+void RoughSphereInView(Eigen::MatrixXd* V, Eigen::MatrixXi* F, PinholeView* view) {
+  MakeIcosphere(5, 1.0, V, F);
   std::mt19937 rng(7);
   std::normal_distribution<double> noise(0.0, 0.005);
-  for (int v = 0; v < V.rows(); ++v) V.row(v) *= 1.0 + noise(rng);
-  big_V = 1.03 * V;
+  for (int v = 0; v < V->rows(); ++v) V->row(v) *= 1.0 + noise(rng);
+  *view = PinholeView();
+  view->width = 320;
+  view->height = 240;
+  view->fx = view->fy = 400;
+  view->cx = 160;
+  view->cy = 120;
+  view->t = Eigen::Vector3d(0, 0, 5);
+}
+
+TEST_F(RefinerTest, SilhouetteTermFollowsTheGapBetweenOutlines) {
+  Eigen::MatrixXd V;
+  Eigen::MatrixXi F;
   PinholeView view;
-  view.width = 320;
-  view.height = 240;
-  view.fx = view.fy = 400;
-  view.cx = 160;
-  view.cy = 120;
-  view.t = Eigen::Vector3d(0, 0, 5);
+  RoughSphereInView(&V, &F, &view);
+  const Eigen::MatrixXd big_V = 1.03 * V;
   renderer_->SetMesh(V, F);
   const RenderBuffers render = renderer_->Render(view);
   renderer_->SetMesh(big_V, F);
@@ -679,17 +685,8 @@ TEST_F(RefinerTest, SilhouetteTermFollowsTheGapBetweenOutlines) {
 TEST_F(RefinerTest, HullPullRetractsWhatLiesOutsideTheMask) {
   Eigen::MatrixXd V;
   Eigen::MatrixXi F;
-  MakeIcosphere(5, 1.0, &V, &F);
-  std::mt19937 rng(7);
-  std::normal_distribution<double> noise(0.0, 0.005);
-  for (int v = 0; v < V.rows(); ++v) V.row(v) *= 1.0 + noise(rng);
   PinholeView view;
-  view.width = 320;
-  view.height = 240;
-  view.fx = view.fy = 400;
-  view.cx = 160;
-  view.cy = 120;
-  view.t = Eigen::Vector3d(0, 0, 5);
+  RoughSphereInView(&V, &F, &view);
   renderer_->SetMesh(V, F);
   const RenderBuffers render = renderer_->Render(view);
   const cv::Mat own_mask = RenderedCoverage(render);
