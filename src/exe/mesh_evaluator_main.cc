@@ -179,12 +179,14 @@ int main(int argc, char** argv) {
     if (!output_error_path.empty()) {
       const mr::VertexErrors errors = mr::MeasureVertexErrors(
           mesh.V, gt.V, gt.F, observed.empty() ? nullptr : &observed);
-      const double max_distance = error_max > 0 ? error_max : result.accuracy90;
+      // The scale's top: given, else the accuracy90 (1 for a perfect mesh).
+      const double max_distance =
+          error_max > 0 ? error_max : (result.accuracy90 > 0 ? result.accuracy90 : 1.0);
       mr::TriangleMesh map;
       map.V = mesh.V;
       map.F = mesh.F;
       map.values = errors.distance;
-      map.C = mr::ErrorColors(errors, max_distance > 0 ? max_distance : 1.0);
+      map.C = mr::ErrorColors(errors, max_distance);
       mr::WritePly(output_error_path, map);
       MR_LOG(INFO) << "Wrote the error map " << output_error_path << " (" << map.NumVertices()
                    << " vertices; yellow at " << max_distance << ")";
