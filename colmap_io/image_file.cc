@@ -98,7 +98,8 @@ ImageHeader ReadPngHeader(const std::string& path, const std::string& data) {
 }
 
 // The first image file directory: ImageWidth (256), ImageLength (257),
-// BitsPerSample (258, the first sample's), SamplesPerPixel (277).
+// BitsPerSample (258, the first sample's), SamplesPerPixel (277),
+// RowsPerStrip (278), TileWidth (322) and TileLength (323).
 ImageHeader ReadTiffHeader(const std::string& path, const std::string& data) {
   const bool le = data[0] == 'I';
   const auto u16 = [&](size_t i) { return le ? Le16(data, i) : Be16(data, i); };
@@ -109,14 +110,22 @@ ImageHeader ReadTiffHeader(const std::string& path, const std::string& data) {
   const uint64_t count = u16(ifd);
   if (ifd + 2 + 12 * count > data.size()) Truncated(path, "TIFF directory runs past the end of the file");
   ImageHeader header{"TIFF", 0, 0, 1, 1};
+  int64_t rows_per_strip = 0, tile_width = 0, tile_length = 0;
   for (uint64_t e = 0; e < count; ++e) {
     const size_t entry = ifd + 2 + 12 * e;
     const uint32_t tag = u16(entry), type = u16(entry + 2), n = u32(entry + 4);
     // SHORT (3) values sit in the first two bytes of the value field, LONG (4) in all four.
     const uint32_t value = type == 3 ? u16(entry + 8) : u32(entry + 8);
-    if (tag == 256) header.width = value;
-    if (tag == 257) header.height = value;
-    if (tag == 277) header.channels = static_cast<int>(std::clamp<uint32_t>(value, 1, 65535));
+    // A tag given twice counts at its largest, whichever copy libtiff keeps.
+    const auto keep_max = [&](auto& field) { field = std::max<decltype(+field)>(field, value); };
+    if (tag == 256) keep_max(header.width);
+    if (tag == 257) keep_max(header.height);
+    if (tag == 277) {
+      header.channels = std::max(header.channels, static_cast<int>(std::clamp<uint32_t>(value, 1, 65535)));
+    }
+    if (tag == 278) keep_max(rows_per_strip);
+    if (tag == 322) keep_max(tile_width);
+    if (tag == 323) keep_max(tile_length);
     if (tag == 258) {
       uint64_t bits = value;
       if (type == 3 && n > 2) {  // more than fit in the field: it holds their offset
@@ -124,8 +133,17 @@ ImageHeader ReadTiffHeader(const std::string& path, const std::string& data) {
         if (at + 2 > data.size()) Truncated(path, "TIFF BitsPerSample past the end of the file");
         bits = u16(at);
       }
-      header.bytes_per_sample = std::max<int>(1, static_cast<int>((bits + 7) / 8));
+      header.bytes_per_sample = std::max<int>(header.bytes_per_sample, static_cast<int>((bits + 7) / 8));
     }
+  }
+  // A missing tile dimension or RowsPerStrip means the image's; libtiff
+  // clamps a strip to the image, but not a tile.
+  if (tile_width > 0 || tile_length > 0) {
+    header.block_width = tile_width > 0 ? tile_width : header.width;
+    header.block_height = tile_length > 0 ? tile_length : header.height;
+  } else {
+    header.block_width = header.width;
+    header.block_height = rows_per_strip > 0 ? std::min(rows_per_strip, header.height) : header.height;
   }
   return header;
 }
@@ -245,6 +263,21 @@ cv::Mat DecodeImageFile(const std::string& path, const std::string& data, int fl
                    << header.height << " pixels would take " << std::llround(decoded / (1 << 20))
                    << " MiB decoded, more than the " << kMaxDecodedImageBytes / (1 << 20)
                    << " MiB read per " << what << " (corrupt header, or split the image)";
+  }
+  // OpenCV's TIFF decoder holds one tile or strip besides the image: as
+  // 32-bit RGBA for 8-bit output, else in the file's channels and depth.
+  const double block_bytes_per_pixel =
+      flags != cv::IMREAD_UNCHANGED || header.bytes_per_sample == 1
+          ? 4.0
+          : static_cast<double>(header.channels) * header.bytes_per_sample;
+  const double block = static_cast<double>(header.block_width) *
+                       static_cast<double>(header.block_height) * block_bytes_per_pixel;
+  if (block > static_cast<double>(kMaxDecodedImageBytes)) {
+    MR_THROW_INPUT << path << ": " << header.format << " tile or strip of " << header.block_width << " x "
+                   << header.block_height << " pixels would take " << std::llround(block / (1 << 20))
+                   << " MiB to decode, more than the " << kMaxDecodedImageBytes / (1 << 20)
+                   << " MiB read per " << what << " (corrupt header, or rewrite the file with "
+                   << "smaller tiles)";
   }
   // cv::IMREAD_UNCHANGED (-1) already ignores the orientation.
   if (flags != cv::IMREAD_UNCHANGED) flags |= cv::IMREAD_IGNORE_ORIENTATION;

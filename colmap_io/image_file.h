@@ -31,6 +31,12 @@ struct ImageHeader {
   int64_t height = 0;
   int channels = 0;          // as OpenCV decodes with IMREAD_UNCHANGED (at most)
   int bytes_per_sample = 0;  // likewise
+  // TIFF only (0 elsewhere): the tile, or the strip clamped to the image,
+  // that OpenCV's decoder buffers whole as 32-bit RGBA for 8-bit output. A
+  // tile's size is the header's TileWidth x TileLength, which may exceed the
+  // image (the fuzz finding: a 16 x 16 TIFF with 2-gigabyte tiles).
+  int64_t block_width = 0;
+  int64_t block_height = 0;
 };
 
 // The header of the image file at `path` whose bytes are `data`. Throws
