@@ -577,6 +577,9 @@ bool RefineOptions::Check() const {
   if (refine_cameras != "none" && refine_cameras != "poses" && refine_cameras != "poses_intrinsics") {
     fail("refine_cameras", refine_cameras, "one of none, poses, poses_intrinsics");
   }
+  if (average_last_iterates < 1) {
+    fail("average_last_iterates", std::to_string(average_last_iterates), "average_last_iterates >= 1");
+  }
   if (camera_rounds < 1) fail("camera_rounds", std::to_string(camera_rounds), "camera_rounds >= 1");
   if (refine_cameras != "none") {
     CameraRefinementOptions cameras = camera_refinement;
@@ -624,6 +627,7 @@ std::string RefineSummary::FullReport() const {
       << " -> " << final_vertices << ", flipped faces fixed " << flipped_faces_fixed
       << ", steps taken back " << steps_taken_back << ", levels ended on their best iterate "
       << levels_ended_on_best << " (" << iterations_dropped << " iterations dropped)"
+      << ", iterates averaged " << iterates_averaged
       << ", intersecting pairs undone " << self_intersections_undone << " (" << vertices_reset
       << " vertex moves reset), self-intersections left " << self_intersections << "\n";
   out << "  surface moved: mean " << mean_displacement << ", max " << max_displacement
@@ -876,6 +880,9 @@ RefineSummary RefineMesh(const ViewSource& input_source, const RefineOptions& op
     Eigen::MatrixXd V_best;
     int best_iteration = 0;
     double best_similarity = -std::numeric_limits<double>::infinity();
+    // The finest level's last average_last_iterates iterates, summed.
+    Eigen::MatrixXd V_sum;
+    int num_summed = 0;
     for (int it = 0; it < options.iterations_per_level; ++it, ++global_iteration) {
       const double t_iter = ElapsedSeconds();
       const long renders_before = renders.num_renders();
@@ -902,6 +909,7 @@ RefineSummary RefineMesh(const ViewSource& input_source, const RefineOptions& op
                              cache_bytes / 2, full_views, &images, &views, &cameras, &summary);
         level_similarities.clear();  // measured through other cameras
         best_similarity = -std::numeric_limits<double>::infinity();
+        num_summed = 0;  // the surface follows the new cameras from here
       }
       const Eigen::MatrixXd V_before = V;
       renderer->SetMesh(V, F);
@@ -957,6 +965,7 @@ RefineSummary RefineMesh(const ViewSource& input_source, const RefineOptions& op
                      << options.min_improvement
                      << (worse ? "; the last step lowered it and is taken back" : "") << ")";
         if (worse) ++summary.steps_taken_back;
+        num_summed = 0;  // converged: the level ends on its last iterate
         global_iteration += options.iterations_per_level - it;
         break;
       }
@@ -1049,6 +1058,11 @@ RefineSummary RefineMesh(const ViewSource& input_source, const RefineOptions& op
         }
       }
       guard_verified_clean = guard && guard->initial_pairs().empty();
+      if (level == 0 && it >= options.iterations_per_level - options.average_last_iterates) {
+        if (num_summed == 0) V_sum = Eigen::MatrixXd::Zero(V.rows(), 3);
+        V_sum += V;
+        ++num_summed;
+      }
 
       record.cleanup_seconds = ElapsedSeconds() - t_cleanup;
       record.seconds = ElapsedSeconds() - t_iter;
@@ -1075,6 +1089,17 @@ RefineSummary RefineMesh(const ViewSource& input_source, const RefineOptions& op
                    << renders.num_renders() - renders_before << " renders); ETA "
                    << FormatSeconds(eta);
       summary.iterations.push_back(record);
+    }
+    if (num_summed > 1) {
+      // The mean of iterates without flipped faces may still flip one where
+      // they disagree, or bring two sheets together: both are checked.
+      const Eigen::MatrixXd V_last = V;
+      V = V_sum / num_summed;
+      summary.flipped_faces_fixed += FixFlippedFaces(V_last, F, &V).initial_flipped;
+      guard_verified_clean = false;
+      summary.iterates_averaged = num_summed;
+      MR_LOG(INFO) << "Level " << level << " ends on the mean of its last " << num_summed
+                   << " iterates (Refine.average_last_iterates)";
     }
     // A level whose similarity fell well below its best while the
     // self-intersection guard was resetting much of the mesh ends on that
@@ -1176,6 +1201,9 @@ void RegisterRefineOptions(OptionManager* o, RefineOptions* r) {
          "alternate halves of the view pairs (0: all pairs always)");
   o->Add("Refine.iterations_per_level", &r->iterations_per_level,
          "gradient + denoising iterations per level (>= 0)");
+  o->Add("Refine.average_last_iterates", &r->average_last_iterates,
+         "the finest level ends on the mean of its last this many iterates, which averages out "
+         "the flow's jitter (>= 1; 1: on the last)");
   o->Add("Refine.max_image_size", &r->max_image_size,
          "longest image side in pixels at which images are compared; larger images and their "
          "cameras are scaled down (-1: no limit)");

@@ -285,6 +285,41 @@ TEST_F(RefinerTest, NoisyMeshGetsCloserToGroundTruth) {
   EXPECT_NE(summary.FullReport().find("  time: setup "), std::string::npos);
 }
 
+// average_last_iterates: the finest level ends on the mean of its last
+// iterates, exactly those that runs of fewer iterations end on, and not on
+// the last alone. (With kappa 0: dcv's kappa grows over the whole run, so a
+// shorter run's iterates differ.)
+TEST_F(RefinerTest, FinestLevelEndsOnTheMeanOfItsLastIterates) {
+  Eigen::MatrixXd V, V0;
+  Eigen::MatrixXi F, F0;
+  MakeBumpyAndSmoothSpheres(&V, &F, &V0, &F0);
+  const InMemoryViewSource source = MakeTestScene(V, F, {}, {}, renderer_);
+  RefineOptions options = FastOptions();
+  options.num_levels = 1;
+  options.kappa = 0;
+  const auto refine = [&](int iterations, int average, RefineSummary* summary) {
+    TriangleMesh mesh;
+    mesh.V = V0;
+    mesh.F = F0;
+    RefineOptions o = options;
+    o.iterations_per_level = iterations;
+    o.average_last_iterates = average;
+    *summary = RefineMesh(source, o, &mesh, renderer_);
+    return mesh;
+  };
+  RefineSummary summary;
+  const TriangleMesh second = refine(2, 1, &summary);
+  EXPECT_EQ(summary.iterates_averaged, 0);
+  const TriangleMesh third = refine(3, 1, &summary);
+  const TriangleMesh averaged = refine(3, 2, &summary);
+  EXPECT_EQ(summary.iterates_averaged, 2) << summary.FullReport();
+  ASSERT_EQ(averaged.F, third.F);
+  const double to_mean = (averaged.V - (second.V + third.V) / 2).rowwise().norm().maxCoeff();
+  const double to_last = (averaged.V - third.V).rowwise().norm().maxCoeff();
+  EXPECT_LT(to_mean, 1e-9) << "furthest from the mean of iterates 2 and 3: " << to_mean;
+  EXPECT_GT(to_last, 1e-4) << "furthest from the 3rd iterate: " << to_last;
+}
+
 // --Refine.pair_halves_min_views: the middle iterations of each level take
 // alternate halves of the pairs, the first and last two all of them, and the
 // relief is recovered as well as with all pairs in every iteration.
