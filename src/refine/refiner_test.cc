@@ -40,6 +40,12 @@ class RefinerTest : public ::testing::Test {
     options.target_edge_px = 3.0;
     return options;
   }
+  // FastOptions at full resolution only.
+  static RefineOptions OneLevelOptions() {
+    RefineOptions options = FastOptions();
+    options.num_levels = 1;
+    return options;
+  }
   static Renderer* renderer_;
 };
 Renderer* RefinerTest::renderer_ = nullptr;
@@ -179,6 +185,23 @@ TEST(IsCameraRound, EvenlySpacedRounds) {
   }
 }
 
+// The defaults' 14 iterations average the last 8; after a camera round the
+// surface first settles for 6 iterations again.
+TEST(AveragedIterations, LastIteratesAfterTheSurfaceSettled) {
+  const auto range = [](int from, int to) {
+    std::vector<int> r;
+    for (int it = from; it <= to; ++it) r.push_back(it);
+    return r;
+  };
+  EXPECT_EQ(AveragedIterations(14, 8, 0), range(6, 13));
+  EXPECT_EQ(AveragedIterations(14, 1, 0), std::vector<int>());
+  EXPECT_EQ(AveragedIterations(4, 8, 0), range(0, 3));  // at most all of them
+  EXPECT_EQ(AveragedIterations(14, 12, 1), range(9, 13));  // round at 7, 2 to settle
+  EXPECT_EQ(AveragedIterations(14, 8, 1), std::vector<int>());  // 13 alone: no mean
+  EXPECT_EQ(AveragedIterations(14, 8, 2), std::vector<int>());  // rounds at 4 and 9
+  EXPECT_EQ(AveragedIterations(20, 16, 2), range(17, 19));  // rounds at 6 and 13
+}
+
 TEST(MeanResetFraction, SeparatesTheShellFromAPlateau) {
   const std::vector<int> beetle = {9156, 10514, 11157, 12497, 13085, 13673};
   EXPECT_GT(MeanResetFraction(beetle, 37470), kGuardOverrideFraction);
@@ -294,8 +317,7 @@ TEST_F(RefinerTest, FinestLevelEndsOnTheMeanOfItsLastIterates) {
   Eigen::MatrixXi F, F0;
   MakeBumpyAndSmoothSpheres(&V, &F, &V0, &F0);
   const InMemoryViewSource source = MakeTestScene(V, F, {}, {}, renderer_);
-  RefineOptions options = FastOptions();
-  options.num_levels = 1;
+  RefineOptions options = OneLevelOptions();
   options.kappa = 0;
   const auto refine = [&](int iterations, int average, RefineSummary* summary) {
     TriangleMesh mesh;
@@ -328,8 +350,7 @@ TEST_F(RefinerTest, PairHalvesInTheMiddleIterations) {
   Eigen::MatrixXi F, F0;
   MakeBumpyAndSmoothSpheres(&V, &F, &V0, &F0);
   const InMemoryViewSource source = MakeTestScene(V, F, {}, {}, renderer_);
-  RefineOptions options = FastOptions();
-  options.num_levels = 1;
+  RefineOptions options = OneLevelOptions();
   RefineOptions halves = options;
   halves.pair_halves_min_views = source.NumViews();
   options.pair_halves_min_views = source.NumViews() + 1;  // off
@@ -547,8 +568,7 @@ TEST_F(RefinerTest, CameraRefinementUndoesPoseError) {
     wrong.Add(truth.Name(i), view, truth.LoadGray(i), truth.LoadMask(i));
   }
   const double error_before = ReprojectionRmsPx(true_views, wrong_views, V);
-  RefineOptions options = FastOptions();
-  options.num_levels = 1;
+  RefineOptions options = OneLevelOptions();
   // The photometric term alone: masks made from the true images' background
   // pull the surface towards the wrong cameras' outlines, as given masks
   // would (with them the cameras end 0.454 px from the truth, not 0.343).
@@ -911,8 +931,7 @@ TEST_F(RefinerTest, InvariantToRotationAndScale) {
   Eigen::MatrixXd V0;
   Eigen::MatrixXi F0;
   MakeIcosphere(4, 1.0, &V0, &F0);
-  RefineOptions options = FastOptions();
-  options.num_levels = 1;
+  RefineOptions options = OneLevelOptions();
   options.iterations_per_level = 4;
 
   TriangleMesh plain;
