@@ -258,17 +258,13 @@ bool IsCameraRound(int it, int iterations, int rounds) {
   return false;
 }
 
-std::vector<int> AveragedIterations(int iterations, int average_last, int camera_rounds) {
-  int settled_from = std::max(0, iterations - average_last);
+int FirstAveragedIteration(int iterations, int average_last, int camera_rounds) {
+  const int settling = std::max(0, iterations - average_last);
+  int first = settling;
   for (int it = 1; camera_rounds > 0 && it < iterations; ++it) {
-    if (IsCameraRound(it, iterations, camera_rounds)) {
-      settled_from = std::max(settled_from, it + iterations - average_last);
-    }
+    if (IsCameraRound(it, iterations, camera_rounds)) first = std::max(first, it + settling);
   }
-  std::vector<int> averaged;
-  for (int it = settled_from; it < iterations; ++it) averaged.push_back(it);
-  if (averaged.size() < 2) averaged.clear();
-  return averaged;
+  return iterations - first >= 2 ? first : iterations;
 }
 
 int BestIterateToKeep(const std::vector<double>& similarities, double giveback) {
@@ -898,11 +894,11 @@ RefineSummary RefineMesh(const ViewSource& input_source, const RefineOptions& op
     // (one round at iteration 7 of 14 followed by the mean of the 7 iterates
     // after it: rocker-head-noise 1.45x the exact-camera run, 1.28x with 10
     // iterations and no mean).
-    const std::vector<int> averaged = AveragedIterations(
-        options.iterations_per_level, options.average_last_iterates,
-        options.refine_cameras != "none" ? options.camera_rounds : 0);
     const int average_from =
-        level == 0 && !averaged.empty() ? averaged.front() : std::numeric_limits<int>::max();
+        level == 0 ? FirstAveragedIteration(options.iterations_per_level,
+                                            options.average_last_iterates,
+                                            options.refine_cameras != "none" ? options.camera_rounds : 0)
+                   : options.iterations_per_level;
     Eigen::MatrixXd V_sum;
     int num_summed = 0;
     for (int it = 0; it < options.iterations_per_level; ++it, ++global_iteration) {
@@ -931,7 +927,6 @@ RefineSummary RefineMesh(const ViewSource& input_source, const RefineOptions& op
                              cache_bytes / 2, full_views, &images, &views, &cameras, &summary);
         level_similarities.clear();  // measured through other cameras
         best_similarity = -std::numeric_limits<double>::infinity();
-        num_summed = 0;  // the surface follows the new cameras from here
       }
       const Eigen::MatrixXd V_before = V;
       renderer->SetMesh(V, F);

@@ -80,7 +80,7 @@ struct RefineOptions {
   // iteration to the next (0.05-0.08 px), and the mean averages the jitter
   // out. The first iterations_per_level - average_last_iterates iterations,
   // and as many after a camera round, let the surface settle and are never
-  // averaged (AveragedIterations); a level that min_improvement ended early
+  // averaged (FirstAveragedIteration); a level that min_improvement ended early
   // ends on its last iterate. On the development corpus 14 iterations
   // averaged over the last 8 beat 10 iterations on 13 of 15 closed surfaces
   // in both accuracy90 and normal error, and lost 0.4 % on one
@@ -265,12 +265,13 @@ struct RefineIteration {
 // `iterations` (camera_rounds): `rounds` times, evenly spaced (1: halfway).
 bool IsCameraRound(int it, int iterations, int rounds);
 
-// The iterations of the finest level whose iterates average_last_iterates
-// averages (ascending; empty when fewer than two): the last `average_last`
-// of `iterations`, less the first iterations - average_last after the last
-// camera round (`camera_rounds` 0: none), in which the surface settles
-// again. The mean of a surface still moving lags behind it.
-std::vector<int> AveragedIterations(int iterations, int average_last, int camera_rounds);
+// The first iteration of the finest level whose iterate average_last_iterates
+// averages, with all after it (`iterations` when fewer than two would be):
+// the last `average_last` of `iterations`, less the first iterations -
+// average_last after the last camera round (`camera_rounds` 0: none), in
+// which the surface settles again. The mean of a surface still moving lags
+// behind it.
+int FirstAveragedIteration(int iterations, int average_last, int camera_rounds);
 
 // Which iterate of a level to keep. `similarities[k]` is the mean
 // similarity of the level's mesh after k iterations (k = 0: its start), the

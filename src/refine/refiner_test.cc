@@ -187,19 +187,14 @@ TEST(IsCameraRound, EvenlySpacedRounds) {
 
 // The defaults' 14 iterations average the last 8; after a camera round the
 // surface first settles for 6 iterations again.
-TEST(AveragedIterations, LastIteratesAfterTheSurfaceSettled) {
-  const auto range = [](int from, int to) {
-    std::vector<int> r;
-    for (int it = from; it <= to; ++it) r.push_back(it);
-    return r;
-  };
-  EXPECT_EQ(AveragedIterations(14, 8, 0), range(6, 13));
-  EXPECT_EQ(AveragedIterations(14, 1, 0), std::vector<int>());
-  EXPECT_EQ(AveragedIterations(4, 8, 0), range(0, 3));  // at most all of them
-  EXPECT_EQ(AveragedIterations(14, 12, 1), range(9, 13));  // round at 7, 2 to settle
-  EXPECT_EQ(AveragedIterations(14, 8, 1), std::vector<int>());  // 13 alone: no mean
-  EXPECT_EQ(AveragedIterations(14, 8, 2), std::vector<int>());  // rounds at 4 and 9
-  EXPECT_EQ(AveragedIterations(20, 16, 2), range(17, 19));  // rounds at 6 and 13
+TEST(FirstAveragedIteration, LastIteratesAfterTheSurfaceSettled) {
+  EXPECT_EQ(FirstAveragedIteration(14, 8, 0), 6);
+  EXPECT_EQ(FirstAveragedIteration(14, 1, 0), 14);   // one iterate: no mean
+  EXPECT_EQ(FirstAveragedIteration(4, 8, 0), 0);     // at most all of them
+  EXPECT_EQ(FirstAveragedIteration(14, 12, 1), 9);   // round at 7, 2 to settle
+  EXPECT_EQ(FirstAveragedIteration(14, 8, 1), 14);   // 13 alone: no mean
+  EXPECT_EQ(FirstAveragedIteration(14, 8, 2), 14);   // rounds at 4 and 9
+  EXPECT_EQ(FirstAveragedIteration(20, 16, 2), 17);  // rounds at 6 and 13
 }
 
 TEST(MeanResetFraction, SeparatesTheShellFromAPlateau) {
