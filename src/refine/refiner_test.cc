@@ -4,6 +4,7 @@
 #include <cmath>
 #include <cstdio>
 #include <random>
+#include <set>
 #include <string>
 #include <vector>
 
@@ -314,6 +315,7 @@ TEST_F(RefinerTest, FinestLevelEndsOnTheMeanOfItsLastIterates) {
   const InMemoryViewSource source = MakeTestScene(V, F, {}, {}, renderer_);
   RefineOptions options = OneLevelOptions();
   options.kappa = 0;
+  options.average_pair_halves = false;  // the shorter runs' iterates take all pairs
   const auto refine = [&](int iterations, int average, RefineSummary* summary) {
     TriangleMesh mesh;
     mesh.V = V0;
@@ -346,6 +348,7 @@ TEST_F(RefinerTest, PairHalvesInTheMiddleIterations) {
   MakeBumpyAndSmoothSpheres(&V, &F, &V0, &F0);
   const InMemoryViewSource source = MakeTestScene(V, F, {}, {}, renderer_);
   RefineOptions options = OneLevelOptions();
+  options.average_last_iterates = 1;  // no averaged iterations, which take halves too
   RefineOptions halves = options;
   halves.pair_halves_min_views = source.NumViews();
   options.pair_halves_min_views = source.NumViews() + 1;  // off
@@ -368,6 +371,50 @@ TEST_F(RefinerTest, PairHalvesInTheMiddleIterations) {
         EXPECT_GE(summary.iterations[it].num_pairs, summary.num_pairs / 2 - 1) << it;
       }
     }
+  }
+  RecordProperty("accuracy90_all_pairs", std::to_string(result[0].accuracy90));
+  RecordProperty("accuracy90_halves", std::to_string(result[1].accuracy90));
+  EXPECT_LT(result[1].accuracy90, 1.1 * result[0].accuracy90);
+  EXPECT_LT(result[1].normal_deg, 1.1 * result[0].normal_deg);
+}
+
+// --Refine.average_pair_halves: the averaged iterations take alternate
+// halves of the pairs (each half in turn), the settling ones all of them,
+// and the relief is recovered as well as with all pairs.
+TEST_F(RefinerTest, AveragedIterationsTakeAlternateHalvesOfThePairs) {
+  Eigen::MatrixXd V, V0;
+  Eigen::MatrixXi F, F0;
+  MakeBumpyAndSmoothSpheres(&V, &F, &V0, &F0);
+  const InMemoryViewSource source = MakeTestScene(V, F, {}, {}, renderer_);
+  RefineOptions options = OneLevelOptions();
+  options.iterations_per_level = 8;
+  options.average_last_iterates = 4;
+  RefineOptions all_pairs = options;
+  all_pairs.average_pair_halves = false;
+  EvaluationResult result[2];
+  for (int k = 0; k < 2; ++k) {
+    TriangleMesh mesh;
+    mesh.V = V0;
+    mesh.F = F0;
+    const RefineSummary summary =
+        RefineMesh(source, k ? options : all_pairs, &mesh, renderer_);
+    result[k] = Evaluate(mesh.V, mesh.F, V, F);
+    EXPECT_EQ(summary.iterates_averaged, 4);
+    ASSERT_EQ(summary.iterations.size(), 8u);
+    std::set<int> sizes;
+    for (int it = 0; it < 8; ++it) {
+      const int num_pairs = summary.iterations[it].num_pairs;
+      if (k == 0 || it < 4) {
+        EXPECT_EQ(num_pairs, summary.num_pairs) << it;
+      } else {
+        EXPECT_LT(num_pairs, summary.num_pairs) << it;
+        sizes.insert(num_pairs);
+        if (it >= 5) {
+          EXPECT_EQ(num_pairs + summary.iterations[it - 1].num_pairs, summary.num_pairs) << it;
+        }
+      }
+    }
+    if (k == 1) EXPECT_EQ(sizes.size(), summary.num_pairs % 2 == 0 ? 1u : 2u);
   }
   RecordProperty("accuracy90_all_pairs", std::to_string(result[0].accuracy90));
   RecordProperty("accuracy90_halves", std::to_string(result[1].accuracy90));

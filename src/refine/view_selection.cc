@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <deque>
+#include <map>
 #include <set>
 
 #include <Eigen/Geometry>
@@ -234,6 +235,21 @@ int RemeshedFaceCount(const std::vector<PinholeView>& views, const Eigen::Matrix
                       const Eigen::MatrixXi& F, double edge_px, int max_faces) {
   const EdgeSizing sizing(views, V, F, edge_px, max_faces);
   return sizing.visible() ? sizing.expected_faces() : 0;
+}
+
+bool GroupsCoverEveryView(const std::vector<std::pair<int, int>>& pairs,
+                          const std::vector<std::vector<std::pair<int, int>>>& groups) {
+  std::map<int, int> pairs_of_view;
+  for (const auto& [a, b] : pairs) ++pairs_of_view[a], ++pairs_of_view[b];
+  for (const auto& group : groups) {
+    if (group.empty()) return false;
+    std::set<int> covered;
+    for (const auto& [a, b] : group) covered.insert({a, b});
+    for (const auto& [view, count] : pairs_of_view) {
+      if (count >= static_cast<int>(groups.size()) && covered.count(view) == 0) return false;
+    }
+  }
+  return true;
 }
 
 double MedianFootprint(const std::vector<PinholeView>& views, const Eigen::MatrixXd& V,

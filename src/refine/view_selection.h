@@ -52,6 +52,12 @@ std::vector<std::pair<int, int>> NeighborPairs(const std::vector<std::vector<int
 std::vector<std::vector<std::pair<int, int>>> SplitPairsCoveringViews(
     const std::vector<std::pair<int, int>>& pairs, int num_groups);
 
+// Whether each group of `groups` (as SplitPairsCoveringViews returns them)
+// is not empty and holds a pair of every view that is in at least groups.size() of `pairs`
+// (a view in fewer pairs cannot be in every group).
+bool GroupsCoverEveryView(const std::vector<std::pair<int, int>>& pairs,
+                          const std::vector<std::vector<std::pair<int, int>>>& groups);
+
 // Median pixel footprint (world units per pixel) of the vertices V (with
 // normals N) over the views that see them (facing the camera, inside the
 // image); 0 if no view sees any vertex.

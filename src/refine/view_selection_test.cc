@@ -149,6 +149,19 @@ TEST(SplitPairsCoveringViews, TwoHalvesEachCoverEveryView) {
   EXPECT_TRUE(none[0].empty() && none[1].empty() && none[2].empty());
 }
 
+TEST(GroupsCoverEveryView, EveryViewInEnoughPairsIsInEveryGroup) {
+  const auto pairs = NeighborPairs(HemisphereNeighbors(100, 3, 7));
+  EXPECT_TRUE(GroupsCoverEveryView(pairs, SplitPairsCoveringViews(pairs, 2)));
+  // A ring of 4 views: (0,1) (1,2) (2,3) (3,0); view 4 in one pair only.
+  const std::vector<std::pair<int, int>> ring = {{0, 1}, {1, 2}, {2, 3}, {0, 3}, {3, 4}};
+  EXPECT_TRUE(GroupsCoverEveryView(ring, {{{0, 1}, {2, 3}, {3, 4}}, {{1, 2}, {0, 3}}}));
+  // View 3 (in 3 pairs) missing from the second group.
+  EXPECT_FALSE(GroupsCoverEveryView(ring, {{{0, 1}, {2, 3}, {0, 3}, {3, 4}}, {{1, 2}}}));
+  // A group without pairs, even where no view is in two pairs.
+  EXPECT_FALSE(GroupsCoverEveryView({{0, 1}}, SplitPairsCoveringViews({{0, 1}}, 2)));
+  EXPECT_TRUE(GroupsCoverEveryView({{0, 1}}, {{{0, 1}}}));
+}
+
 // A square of half-side `half` at depth z, facing the origin (-z), as a grid
 // of n x n cells appended to (V, F).
 void AppendSquareFacingOrigin(double half, double z, int n, Eigen::MatrixXd* V,
