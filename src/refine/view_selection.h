@@ -49,6 +49,10 @@ std::vector<std::pair<int, int>> NeighborPairs(const std::vector<std::vector<int
 // the smallest group), then a view missing from a group takes one of its
 // pairs from a group where both views of that pair have another. On 100
 // hemisphere views with 3 neighbours each, both halves cover every view.
+// Two groups that still leave a view in two or more pairs out of one (sparse
+// rings) are made instead by colouring the pairs in turn along Euler
+// circuits of the pair graph, which covers every such view unless a
+// component is an odd cycle (GroupsCoverEveryView tells).
 std::vector<std::vector<std::pair<int, int>>> SplitPairsCoveringViews(
     const std::vector<std::pair<int, int>>& pairs, int num_groups);
 

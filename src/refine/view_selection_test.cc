@@ -162,6 +162,38 @@ TEST(GroupsCoverEveryView, EveryViewInEnoughPairsIsInEveryGroup) {
   EXPECT_TRUE(GroupsCoverEveryView({{0, 1}}, {{{0, 1}}}));
 }
 
+// Sparse pair graphs, where a greedy split leaves views out (templeSparseRing:
+// 12 views in 17 pairs): every view in two or more pairs is in both halves,
+// unless a component is an odd cycle, which no split can serve.
+TEST(SplitPairsCoveringViews, SparseGraphsAreCoveredUnlessAnOddCycle) {
+  std::mt19937 rng(7);
+  int graphs = 0;
+  for (int trial = 0; trial < 300; ++trial) {
+    const int n = 6 + trial % 30;
+    const int m = n + n / 2 + static_cast<int>(rng() % (n / 2 + 1));
+    std::set<std::pair<int, int>> unique;
+    for (int v = 0; v < n; ++v) unique.insert({v, (v + 1) % n});  // a ring: connected
+    while (static_cast<int>(unique.size()) < m) {
+      int a = static_cast<int>(rng() % n), b = static_cast<int>(rng() % n);
+      if (a == b) continue;
+      unique.insert({std::min(a, b), std::max(a, b)});
+    }
+    std::vector<std::pair<int, int>> pairs;
+    for (const auto& [a, b] : unique) pairs.push_back({std::min(a, b), std::max(a, b)});
+    std::shuffle(pairs.begin(), pairs.end(), rng);
+    const auto halves = SplitPairsCoveringViews(pairs, 2);
+    EXPECT_TRUE(GroupsCoverEveryView(pairs, halves)) << "trial " << trial;
+    EXPECT_EQ(halves[0].size() + halves[1].size(), pairs.size());
+    ++graphs;
+  }
+  EXPECT_EQ(graphs, 300);
+  // An even cycle splits; an odd one cannot.
+  EXPECT_TRUE(GroupsCoverEveryView({{0, 1}, {1, 2}, {2, 3}, {0, 3}},
+                                   SplitPairsCoveringViews({{0, 1}, {1, 2}, {2, 3}, {0, 3}}, 2)));
+  EXPECT_FALSE(GroupsCoverEveryView({{0, 1}, {1, 2}, {0, 2}},
+                                    SplitPairsCoveringViews({{0, 1}, {1, 2}, {0, 2}}, 2)));
+}
+
 // A square of half-side `half` at depth z, facing the origin (-z), as a grid
 // of n x n cells appended to (V, F).
 void AppendSquareFacingOrigin(double half, double z, int n, Eigen::MatrixXd* V,
