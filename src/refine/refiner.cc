@@ -1187,6 +1187,7 @@ RefineSummary RefineMesh(const ViewSource& input_source, const RefineOptions& op
       // for the best-iterate rule (the averaged iterations measured halves).
       // It is the final pass's, whose renders also give the vertex colours;
       // both stand unless the mesh changes again.
+      renders.Invalidate();  // of the last iterate; the final pass renders within the same budget
       measure_final_pass();
       level_similarities.push_back(final_pass->similarity);
       MR_LOG(INFO) << "Level " << level << " ends on the mean of its last " << num_summed

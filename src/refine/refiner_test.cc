@@ -414,7 +414,9 @@ TEST_F(RefinerTest, AveragedIterationsTakeAlternateHalvesOfThePairs) {
         }
       }
     }
-    if (k == 1) EXPECT_EQ(sizes.size(), summary.num_pairs % 2 == 0 ? 1u : 2u);
+    if (k == 1) {
+      EXPECT_EQ(sizes.size(), summary.num_pairs % 2 == 0 ? 1u : 2u);
+    }
   }
   RecordProperty("accuracy90_all_pairs", std::to_string(result[0].accuracy90));
   RecordProperty("accuracy90_halves", std::to_string(result[1].accuracy90));
@@ -819,7 +821,9 @@ TEST_F(RefinerTest, HullPullRetractsWhatLiesOutsideTheMask) {
       // outside, toward the image centre (near the edge the nearest inside
       // pixel may lie to the side).
       EXPECT_NEAR(d(v, 2), 0, 1e-9 * d.row(v).norm()) << v;
-      if (px > 1) EXPECT_LT(d(v, 0) * x.x() + d(v, 1) * x.y(), 0) << v;
+      if (px > 1) {
+        EXPECT_LT(d(v, 0) * x.x() + d(v, 1) * x.y(), 0) << v;
+      }
     }
     std::printf("%s mask: %d vertices off the contour pulled, %d by the full %.0f px; largest "
                 "%.3f px\n", small ? "smaller sphere's" : "own", pulled, capped, max_px,
@@ -836,7 +840,9 @@ TEST_F(RefinerTest, HullPullRetractsWhatLiesOutsideTheMask) {
   Eigen::VectorXd count = Eigen::VectorXd::Zero(V.rows());
   AccumulateSilhouetteTerm(V, F, N, view, render, small_mask, max_px, -1, &d, &count);
   for (int v = 0; v < V.rows(); ++v) {
-    if (!(front[v] && back[v])) EXPECT_EQ(count(v), 0) << v;
+    if (!(front[v] && back[v])) {
+      EXPECT_EQ(count(v), 0) << v;
+    }
   }
 }
 
