@@ -771,14 +771,15 @@ RefineSummary RefineMesh(const ViewSource& input_source, const RefineOptions& op
   // middle iterations of every level too.
   const bool many_views =
       options.pair_halves_min_views > 0 && source.NumViews() >= options.pair_halves_min_views;
+  const bool averaged_halves = options.average_pair_halves && options.average_last_iterates >= 2;
   std::vector<std::vector<std::pair<int, int>>> pair_halves;
-  if (many_views || (options.average_pair_halves && options.average_last_iterates >= 2)) {
+  if (many_views || averaged_halves) {
     pair_halves = SplitPairsCoveringViews(pairs, 2);
     if (!many_views && !GroupsCoverEveryView(pairs, pair_halves)) pair_halves.clear();
   }
   if (!pair_halves.empty()) {
     std::vector<std::string> users;
-    if (options.average_pair_halves && options.average_last_iterates >= 2) {
+    if (averaged_halves) {
       users.push_back("the finest level's averaged iterations");
     }
     if (many_views) {
@@ -939,14 +940,14 @@ RefineSummary RefineMesh(const ViewSource& input_source, const RefineOptions& op
     // Whether iteration k of the level uses all pairs. The averaged
     // iterations take alternate halves: the mean sees every pair as often,
     // and each half's jitter is its own, so the mean averages more of it
-    // (development corpus: better on 13 and 14 of 16 cases, for 40 % less
-    // data term in those iterations; docs/results.md). Only the similarities
+    // (development corpus: better on 13 of 16 cases in each figure, for
+    // about a third less data term in those iterations; docs/results.md). Only the similarities
     // of all pairs are compared with each other (min_improvement,
     // best_iterate_giveback).
     // The first iteration always takes all pairs (it measures the start).
     auto uses_all_pairs = [&](int k) {
       if (pair_halves.empty() || k == 0) return true;
-      if (options.average_pair_halves && averages && k >= average_from) return false;
+      if (averaged_halves && averages && k >= average_from) return false;
       return !(many_views && k < options.iterations_per_level - 2);
     };
     double previous_similarity = 0;

@@ -89,10 +89,10 @@ struct RefineOptions {
   // The averaged iterations take alternate halves of the view pairs, each
   // half covering every view (GroupsCoverEveryView; all pairs when the split
   // cannot). The mean sees every pair as often, each half's jitter is its
-  // own, and those iterations cost about 30 % less. Against all pairs, on
-  // the development corpus: better on 13 of 16 cases in accuracy90 and on 14
-  // in normal error, worst closed surface 0.632 / 0.796 against 0.638 /
-  // 0.806 (docs/results.md).
+  // own, and those iterations cost about a third less data term. Against
+  // all pairs, on the development corpus: better on 13 of 16 cases in
+  // accuracy90 and on 13 in normal error, worst closed surface 0.630 / 0.800
+  // against 0.638 / 0.806 (docs/results.md).
   bool average_pair_halves = true;
   // A level ends early when the last step raised the mean ZNCC of all pairs
   // by less than this (ZNCC units, >= 0; 0 = always run
