@@ -112,6 +112,23 @@ void AppendFootprints(const std::vector<PinholeView>& views, const Eigen::Vector
 // The upper median of the values (reorders them); 0 if none.
 double UpperMedian(std::vector<double>* values) { return values->empty() ? 0 : Median(values); }
 
+// A point's footprints in the views that see it, less those of the views
+// that see it coarser than its sharpest pair by more than kSharpSpread: the
+// pair term compares such a view with a sharper one at its own, coarser,
+// resolution, so it cannot tell the mesh anything finer. Views taken from
+// near and far (close-ups among overview shots) leave the far ones out; an
+// object seen from around at one distance, whose views see a point over less
+// than a factor 1.6 in depth up to 75 degrees off its normal, keeps them all.
+// Sorts the values.
+void KeepSharpFootprints(std::vector<double>* footprints) {
+  constexpr double kSharpSpread = 1.6817928305074290;  // 2^(3/4)
+  if (footprints->size() < 3) return;
+  std::sort(footprints->begin(), footprints->end());
+  const double limit = kSharpSpread * (*footprints)[1];
+  footprints->erase(std::upper_bound(footprints->begin(), footprints->end(), limit),
+                    footprints->end());
+}
+
 }  // namespace
 
 EdgeSizing::EdgeSizing(std::vector<PinholeView> views, const Eigen::MatrixXd& V,
@@ -213,6 +230,7 @@ double EdgeSizing::Footprint(const Eigen::Vector3d& x, const Eigen::Vector3d& n)
   std::vector<double> footprints;
   footprints.reserve(views_.size());
   AppendFootprints(views_, x, n, &footprints);
+  KeepSharpFootprints(&footprints);
   return UpperMedian(&footprints);
 }
 
@@ -254,9 +272,14 @@ bool GroupsCoverEveryView(const std::vector<std::pair<int, int>>& pairs,
 
 double MedianFootprint(const std::vector<PinholeView>& views, const Eigen::MatrixXd& V,
                        const Eigen::MatrixXd& N) {
-  std::vector<double> footprints;
+  std::vector<double> footprints, point;
   const int stride = std::max<int>(1, static_cast<int>(V.rows() / 5000));
-  for (int v = 0; v < V.rows(); v += stride) AppendFootprints(views, V.row(v), N.row(v), &footprints);
+  for (int v = 0; v < V.rows(); v += stride) {
+    point.clear();
+    AppendFootprints(views, V.row(v), N.row(v), &point);
+    KeepSharpFootprints(&point);
+    footprints.insert(footprints.end(), point.begin(), point.end());
+  }
   return UpperMedian(&footprints);
 }
 

@@ -64,7 +64,9 @@ bool GroupsCoverEveryView(const std::vector<std::pair<int, int>>& pairs,
 
 // Median pixel footprint (world units per pixel) of the vertices V (with
 // normals N) over the views that see them (facing the camera, inside the
-// image); 0 if no view sees any vertex.
+// image), less, for each vertex, the views that see it more than 2^(3/4)
+// times coarser than its sharpest pair (views from near and far: the far ones
+// cannot resolve what the near pairs compare); 0 if no view sees any vertex.
 double MedianFootprint(const std::vector<PinholeView>& views, const Eigen::MatrixXd& V,
                        const Eigen::MatrixXd& N);
 
@@ -83,7 +85,8 @@ double BestViewCoverage(const std::vector<PinholeView>& views, const Eigen::Matr
 //
 // A point's footprint is the median of depth / focal length over the views
 // that see it (in front, facing it, inside the image; occlusion is not
-// tested). The surface is divided into bands half an octave wide, centred on
+// tested), less those more than 2^(3/4) times coarser than its sharpest
+// pair (as MedianFootprint). The surface is divided into bands half an octave wide, centred on
 // the footprint that the most area shares (the area-weighted median footprint
 // in the half-octave window that holds the most area, f0: e.g. the object's,
 // where a ground recedes behind it): the points within a factor 2^(1/4) of

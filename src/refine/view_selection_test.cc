@@ -261,12 +261,57 @@ TEST(EdgeSizing, ObjectSeenFromAroundIsUniform) {
   EXPECT_TRUE(sizing.uniform());
   EXPECT_DOUBLE_EQ(sizing.band_edges()[0],
                    2.5 * MedianFootprint(views, V, VertexNormals(V, F)));
+  // Every view that sees a vertex counts: the median of all their footprints.
+  const Eigen::MatrixXd N = VertexNormals(V, F);
+  std::vector<double> footprints;
+  for (int v = 0; v < V.rows(); ++v) {
+    for (const PinholeView& view : views) {
+      const Eigen::Vector3d x = V.row(v), xc = view.WorldToCamera(x);
+      if (xc.z() > 0 && N.row(v).dot(view.Center() - x) > 0 &&
+          view.InImage(view.CameraToImage(xc))) {
+        footprints.push_back(xc.z() / view.fx);
+      }
+    }
+  }
+  std::nth_element(footprints.begin(), footprints.begin() + footprints.size() / 2, footprints.end());
+  EXPECT_DOUBLE_EQ(MedianFootprint(views, V, N), footprints[footprints.size() / 2]);
   // Not seen at all.
   const std::vector<PinholeView> away = {LookAtView(Eigen::Vector3d(10, 0, 0),
                                                     Eigen::Vector3d(20, 0, 0),
                                                     Eigen::Vector3d(0, 0, 1), 640, 480, 500)};
   EXPECT_FALSE(EdgeSizing(away, V, F, 2.5, 1000000).visible());
   EXPECT_EQ(RemeshedFaceCount(away, V, F, 2.5, 1000000), 0);
+}
+
+// Close-ups among overview shots: every other view of three rings is twice
+// as far. The pair term compares a near view with a far one at the far one's
+// resolution, but two near views at their own, so the mesh is sized by the
+// near views, as if the far ones were not there.
+TEST(EdgeSizing, ViewsFromNearAndFarSizeByTheNearOnes) {
+  Eigen::MatrixXd V;
+  Eigen::MatrixXi F;
+  MakeIcosphere(3, 1.0, &V, &F);
+  std::vector<PinholeView> views, near, far;
+  for (int ring = -1; ring <= 1; ++ring) {
+    const double elevation = ring * M_PI / 3;
+    for (int i = 0; i < 12; ++i) {
+      const double a = 2 * M_PI * (i + 0.5 * ring) / 12, distance = i % 2 == 0 ? 4 : 8;
+      const Eigen::Vector3d direction(std::cos(elevation) * std::cos(a),
+                                      std::cos(elevation) * std::sin(a), std::sin(elevation));
+      views.push_back(LookAtView(distance * direction, Eigen::Vector3d::Zero(),
+                                 Eigen::Vector3d(0, 0, 1), 640, 480, 500));
+      (i % 2 == 0 ? near : far).push_back(views.back());
+    }
+  }
+  const Eigen::MatrixXd N = VertexNormals(V, F);
+  const double near_footprint = MedianFootprint(near, V, N);
+  const double far_footprint = MedianFootprint(far, V, N);
+  ASSERT_GT(far_footprint, 1.8 * near_footprint);
+  EXPECT_NEAR(MedianFootprint(views, V, N) / near_footprint, 1.0, 0.02);
+  const EdgeSizing sizing(views, V, F, 2.5, 1000000);
+  ASSERT_TRUE(sizing.visible());
+  EXPECT_TRUE(sizing.uniform());
+  EXPECT_NEAR(sizing.band_edges()[0] / (2.5 * near_footprint), 1.0, 0.02);
 }
 
 }  // namespace
