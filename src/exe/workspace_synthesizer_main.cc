@@ -51,7 +51,8 @@ int main(int argc, char** argv) {
                 "fraction of the image height the object's bounding sphere fills");
     options.Add("alternate_fill_fraction", &o.cameras.alternate_fill_fraction,
                 "the odd-numbered views at this fill fraction instead: a capture from two "
-                "distances (0: all at fill_fraction)");
+                "distances; above 1, close-ups of the object's middle (0: all at fill_fraction; "
+                "at most 3)");
     options.Add("supersample", &o.supersample, "supersampling factor per axis (anti-aliasing)");
     options.Add("image_noise", &o.image_noise,
                 "Gaussian image noise per pixel and channel (standard deviation, radiance in "

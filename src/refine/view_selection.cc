@@ -119,14 +119,25 @@ double UpperMedian(std::vector<double>* values) { return values->empty() ? 0 : M
 // near and far (close-ups among overview shots) leave the far ones out; an
 // object seen from around at one distance, whose views see a point over less
 // than a factor 1.6 in depth up to 75 degrees off its normal, keeps them all.
-// Sorts the values.
+// The sharp views make the point's footprint at most an octave finer than
+// the upper median of all (the kept values are scaled up to it): close-ups
+// three times sharper than the rest, sized by their own footprint, left a
+// mesh whose faces the far views see at under a pixel, and the flow flipped
+// 13 times as many of them (builtin with alternate_fill_fraction 1.4: normal
+// error 0.68x -> 0.94x the input). Sorts the values.
 void KeepSharpFootprints(std::vector<double>* footprints) {
-  constexpr double kSharpSpread = 1.6817928305074290;  // 2^(3/4)
+  constexpr double kSharpSpread = 1.6817928305074290;    // 2^(3/4)
+  constexpr double kMaxSharpening = 2;                   // an octave
   if (footprints->size() < 3) return;
   std::sort(footprints->begin(), footprints->end());
+  const double median = (*footprints)[footprints->size() / 2];
   const double limit = kSharpSpread * (*footprints)[1];
   footprints->erase(std::upper_bound(footprints->begin(), footprints->end(), limit),
                     footprints->end());
+  const double sharp = (*footprints)[footprints->size() / 2];
+  if (sharp * kMaxSharpening < median) {
+    for (double& footprint : *footprints) footprint *= median / (kMaxSharpening * sharp);
+  }
 }
 
 }  // namespace

@@ -66,7 +66,9 @@ bool GroupsCoverEveryView(const std::vector<std::pair<int, int>>& pairs,
 // normals N) over the views that see them (facing the camera, inside the
 // image), less, for each vertex, the views that see it more than 2^(3/4)
 // times coarser than its sharpest pair (views from near and far: the far ones
-// cannot resolve what the near pairs compare); 0 if no view sees any vertex.
+// cannot resolve what the near pairs compare), the rest making the vertex's
+// footprint at most an octave finer than the median of all; 0 if no view
+// sees any vertex.
 double MedianFootprint(const std::vector<PinholeView>& views, const Eigen::MatrixXd& V,
                        const Eigen::MatrixXd& N);
 

@@ -63,9 +63,9 @@ bool CameraRigOptions::Check() const {
     MR_THROW_INPUT << "CameraRigOptions::fill_fraction = " << fill_fraction
                    << ". Violated constraint: 0 < fill_fraction <= 1";
   }
-  if (!(alternate_fill_fraction >= 0 && alternate_fill_fraction <= 1)) {
+  if (!(alternate_fill_fraction >= 0 && alternate_fill_fraction <= 3)) {
     MR_THROW_INPUT << "CameraRigOptions::alternate_fill_fraction = " << alternate_fill_fraction
-                   << ". Violated constraint: 0 <= alternate_fill_fraction <= 1";
+                   << ". Violated constraint: 0 <= alternate_fill_fraction <= 3";
   }
   if (!(focal_factor > 0.1 && focal_factor <= 10)) {
     MR_THROW_INPUT << "CameraRigOptions::focal_factor = " << focal_factor

@@ -37,7 +37,8 @@ struct CameraRigOptions {
   // The odd-numbered views at this fill fraction instead: a capture from two
   // distances, whose views see the surface at pixel footprints up to
   // alternate_fill_fraction / fill_fraction apart. 0: every view at
-  // fill_fraction. [0, 1].
+  // fill_fraction. Above 1 the odd views are close-ups that see only the
+  // middle of the object. [0, 3].
   double alternate_fill_fraction = 0;
   // Focal length in pixels as a multiple of the image width (0.9 ~ 58 deg
   // horizontal field of view). Range (0.1, 10].

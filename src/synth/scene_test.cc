@@ -72,7 +72,14 @@ TEST(MakeCameras, AlternateFillFractionPutsTheOddViewsAtAnotherDistance) {
   }
   // About twice as far: the far views' pixels cover about twice the surface.
   EXPECT_NEAR(views[0].Center().norm() / views[1].Center().norm(), 2.0, 0.1);
+  // Close-ups that see only the middle of the object: the bounding sphere
+  // fills 1.5 times the image height, from outside it.
   rig.alternate_fill_fraction = 1.5;
+  const std::vector<PinholeView> closeups = MakeCameras(rig, 40.0);
+  EXPECT_NEAR(std::tan(std::asin(40.0 / closeups[1].Center().norm())) * closeups[1].fy,
+              0.5 * 1.5 * 480, 1e-6);
+  EXPECT_GT(closeups[1].Center().norm(), 40.0);
+  rig.alternate_fill_fraction = 3.5;
   EXPECT_THROW(MakeCameras(rig, 40.0), InputError);
 }
 
