@@ -283,27 +283,34 @@ TEST(EdgeSizing, ObjectSeenFromAroundIsUniform) {
   EXPECT_EQ(RemeshedFaceCount(away, V, F, 2.5, 1000000), 0);
 }
 
-// Three rings of views around a unit sphere, every other view of each ring
-// at `far_distance` instead of 4: close-ups among overview shots. Sets the
-// near and the far views' median footprints.
-std::vector<PinholeView> NearAndFarViews(double far_distance, const Eigen::MatrixXd& V,
-                                         const Eigen::MatrixXd& N, double* near_footprint,
-                                         double* far_footprint) {
-  std::vector<PinholeView> views, near, far;
+// A unit sphere seen by three rings of views, every other view of each ring
+// at `far_distance` instead of 4: close-ups among overview shots.
+struct NearAndFarScene {
+  Eigen::MatrixXd V, N;
+  Eigen::MatrixXi F;
+  std::vector<PinholeView> views;
+  double near_footprint = 0, far_footprint = 0;  // the near and far views' medians
+};
+
+NearAndFarScene MakeNearAndFarScene(double far_distance) {
+  NearAndFarScene scene;
+  MakeIcosphere(3, 1.0, &scene.V, &scene.F);
+  scene.N = VertexNormals(scene.V, scene.F);
+  std::vector<PinholeView> near, far;
   for (int ring = -1; ring <= 1; ++ring) {
     const double elevation = ring * M_PI / 3;
     for (int i = 0; i < 12; ++i) {
       const double a = 2 * M_PI * (i + 0.5 * ring) / 12, distance = i % 2 == 0 ? 4 : far_distance;
       const Eigen::Vector3d direction(std::cos(elevation) * std::cos(a),
                                       std::cos(elevation) * std::sin(a), std::sin(elevation));
-      views.push_back(LookAtView(distance * direction, Eigen::Vector3d::Zero(),
-                                 Eigen::Vector3d(0, 0, 1), 640, 480, 500));
-      (i % 2 == 0 ? near : far).push_back(views.back());
+      scene.views.push_back(LookAtView(distance * direction, Eigen::Vector3d::Zero(),
+                                       Eigen::Vector3d(0, 0, 1), 640, 480, 500));
+      (i % 2 == 0 ? near : far).push_back(scene.views.back());
     }
   }
-  *near_footprint = MedianFootprint(near, V, N);
-  *far_footprint = MedianFootprint(far, V, N);
-  return views;
+  scene.near_footprint = MedianFootprint(near, scene.V, scene.N);
+  scene.far_footprint = MedianFootprint(far, scene.V, scene.N);
+  return scene;
 }
 
 // The pair term compares a near view with a far one at the far one's
@@ -311,43 +318,33 @@ std::vector<PinholeView> NearAndFarViews(double far_distance, const Eigen::Matri
 // twice as far, the mesh is sized by the near views, as if the far ones were
 // not there.
 TEST(EdgeSizing, ViewsFromNearAndFarSizeByTheNearOnes) {
-  Eigen::MatrixXd V;
-  Eigen::MatrixXi F;
-  MakeIcosphere(3, 1.0, &V, &F);
-  const Eigen::MatrixXd N = VertexNormals(V, F);
-  double near_footprint, far_footprint;
-  const std::vector<PinholeView> views = NearAndFarViews(7.5, V, N, &near_footprint, &far_footprint);
-  ASSERT_GT(far_footprint, 1.8 * near_footprint);
-  EXPECT_NEAR(MedianFootprint(views, V, N) / near_footprint, 1.0, 0.02);
-  const EdgeSizing sizing(views, V, F, 2.5, 1000000);
+  const NearAndFarScene s = MakeNearAndFarScene(7.5);
+  ASSERT_GT(s.far_footprint, 1.8 * s.near_footprint);
+  EXPECT_NEAR(MedianFootprint(s.views, s.V, s.N) / s.near_footprint, 1.0, 0.02);
+  const EdgeSizing sizing(s.views, s.V, s.F, 2.5, 1000000);
   ASSERT_TRUE(sizing.visible());
   EXPECT_TRUE(sizing.uniform());
-  EXPECT_NEAR(sizing.band_edges()[0] / (2.5 * near_footprint), 1.0, 0.02);
+  EXPECT_NEAR(sizing.band_edges()[0] / (2.5 * s.near_footprint), 1.0, 0.02);
 }
 
 // Close-ups four times sharper than the rest make the mesh an octave finer
 // than the median of all the views, not more: the far views, which the
 // close-ups are compared with, would see its faces at a fraction of a pixel.
 TEST(EdgeSizing, CloseUpsSharpenTheMeshByAnOctaveAtMost) {
-  Eigen::MatrixXd V;
-  Eigen::MatrixXi F;
-  MakeIcosphere(3, 1.0, &V, &F);
-  const Eigen::MatrixXd N = VertexNormals(V, F);
-  double near_footprint, far_footprint;
-  const std::vector<PinholeView> views = NearAndFarViews(16, V, N, &near_footprint, &far_footprint);
-  ASSERT_GT(far_footprint, 3.5 * near_footprint);
+  const NearAndFarScene s = MakeNearAndFarScene(16);
+  ASSERT_GT(s.far_footprint, 3.5 * s.near_footprint);
   // Each vertex's upper median is a far view's (as many far views as near
   // ones see it, or more), so the sharp views give half of it.
-  EXPECT_NEAR(MedianFootprint(views, V, N) / (0.5 * far_footprint), 1.0, 0.03);
+  EXPECT_NEAR(MedianFootprint(s.views, s.V, s.N) / (0.5 * s.far_footprint), 1.0, 0.03);
   // The surface facing the views gets that length, to the bands' 19 %
   // (the close-ups' own footprint would give half of it).
-  const EdgeSizing sizing(views, V, F, 2.5, 1000000);
+  const EdgeSizing sizing(s.views, s.V, s.F, 2.5, 1000000);
   ASSERT_TRUE(sizing.visible());
   for (int k = 0; k < 24; ++k) {
     const double a = 2 * M_PI * k / 24;
     const Eigen::Vector3d x(std::cos(a), std::sin(a), 0);
     const double edge = sizing.band_edges()[sizing.BandOf(x, x)];
-    EXPECT_NEAR(edge / (2.5 * 0.5 * far_footprint), 1.0, 0.19) << k;
+    EXPECT_NEAR(edge / (2.5 * 0.5 * s.far_footprint), 1.0, 0.19) << k;
   }
 }
 
