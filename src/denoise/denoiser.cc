@@ -48,34 +48,10 @@ void DenoiseLp(const Eigen::MatrixXd& V0, const Eigen::MatrixXi& F, const Denois
                const Eigen::MatrixXd* noise_reference, DenoiseResult* result) {
   const double t0 = Now();
   const int n = static_cast<int>(V0.rows());
-  EdgeQuads eq = BuildEdgeQuads(F, n);
-  result->num_skipped_edges = eq.num_boundary + eq.num_non_manifold;
-  if (eq.quads.rows() == 0) {
-    result->passed_through = true;
-    result->V = V0;
-    MR_LOG(INFO) << "Denoise: no interior edge (" << F.rows() << " faces); mesh passed through";
-    return;
-  }
-  // Normalise: centroid at the origin, unit mean edge length (over face edges).
-  Eigen::RowVector3d centre;
-  double h = 0;
-  if (!NormalizationOf(V0, F, &centre, &h)) {
-    result->passed_through = true;
-    result->V = V0;
-    MR_LOG(WARNING) << "Denoise: all edges have zero length; mesh passed through";
-    return;
-  }
-  const Eigen::MatrixXd X0 = (V0.rowwise() - centre) / h;
+  EdgeProblem problem;
+  if (!SetUpEdgeProblem(V0, F, "Denoise", result, &problem)) return;
+  auto [eq, centre, h, X0, W, degenerate] = std::move(problem);
   Eigen::MatrixXd X = X0;
-
-  int degenerate = 0;
-  Eigen::MatrixXd W = EdgeWeights(X0, eq.quads, &degenerate);
-  result->num_operator_rows = static_cast<int>(eq.quads.rows()) - degenerate;
-  if (eq.num_boundary + eq.num_non_manifold + degenerate > 0) {
-    MR_LOG(VERBOSE) << "Denoise: skipped " << eq.num_boundary << " boundary, "
-                    << eq.num_non_manifold << " non-manifold and " << degenerate
-                    << " degenerate edges";
-  }
   NormalMatrix normal(eq.quads, n);
   SparseCholesky solver;
   const bool direct = o.linear_solver == "cholesky";

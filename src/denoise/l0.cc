@@ -58,37 +58,45 @@ Eigen::MatrixXd RegularizerWeights(const Eigen::MatrixXi& quads) {
   return W;
 }
 
+bool SetUpEdgeProblem(const Eigen::MatrixXd& V0, const Eigen::MatrixXi& F, const char* label,
+                      DenoiseResult* result, EdgeProblem* problem) {
+  EdgeProblem& p = *problem;
+  p.eq = BuildEdgeQuads(F, static_cast<int>(V0.rows()));
+  result->num_skipped_edges = p.eq.num_boundary + p.eq.num_non_manifold;
+  if (p.eq.quads.rows() == 0) {
+    result->passed_through = true;
+    result->V = V0;
+    MR_LOG(INFO) << label << ": no interior edge (" << F.rows() << " faces); mesh passed through";
+    return false;
+  }
+  if (!NormalizationOf(V0, F, &p.centre, &p.h)) {
+    result->passed_through = true;
+    result->V = V0;
+    MR_LOG(WARNING) << label << ": all edges have zero length; mesh passed through";
+    return false;
+  }
+  p.X0 = (V0.rowwise() - p.centre) / p.h;
+  p.W = EdgeWeights(p.X0, p.eq.quads, &p.degenerate);
+  result->num_operator_rows = static_cast<int>(p.eq.quads.rows()) - p.degenerate;
+  if (p.eq.num_boundary + p.eq.num_non_manifold + p.degenerate > 0) {
+    MR_LOG(VERBOSE) << label << ": skipped " << p.eq.num_boundary << " boundary, "
+                    << p.eq.num_non_manifold << " non-manifold and " << p.degenerate
+                    << " degenerate edges";
+  }
+  return true;
+}
+
 void DenoiseL0(const Eigen::MatrixXd& V0, const Eigen::MatrixXi& F, const DenoiseOptions& o,
                DenoiseResult* result) {
   const double t0 = Now();
   const int n = static_cast<int>(V0.rows());
-  const EdgeQuads eq = BuildEdgeQuads(F, n);
-  result->num_skipped_edges = eq.num_boundary + eq.num_non_manifold;
-  if (eq.quads.rows() == 0) {
-    result->passed_through = true;
-    result->V = V0;
-    MR_LOG(INFO) << "Denoise l0: no interior edge (" << F.rows()
-                 << " faces); mesh passed through";
-    return;
-  }
-  // Normalise: centroid at the origin, unit mean edge length l_e. In these
-  // units lambda = l0_lambda_factor * gamma, and beta and alpha (which weigh
-  // squared lengths against squared lengths through dimensionless weights)
-  // need no conversion.
-  Eigen::RowVector3d centre;
-  double h = 0;
-  if (!NormalizationOf(V0, F, &centre, &h)) {
-    result->passed_through = true;
-    result->V = V0;
-    MR_LOG(WARNING) << "Denoise l0: all edges have zero length; mesh passed through";
-    return;
-  }
-  const Eigen::MatrixXd X0 = (V0.rowwise() - centre) / h;
+  EdgeProblem problem;
+  if (!SetUpEdgeProblem(V0, F, "Denoise l0", result, &problem)) return;
+  // In units of h, lambda = l0_lambda_factor * gamma, and beta and alpha
+  // (which weigh squared lengths against squared lengths through
+  // dimensionless weights) need no conversion.
+  auto [eq, centre, h, X0, W, degenerate] = std::move(problem);
   Eigen::MatrixXd X = X0;
-
-  int degenerate = 0;
-  Eigen::MatrixXd W = EdgeWeights(X0, eq.quads, &degenerate);
-  result->num_operator_rows = static_cast<int>(eq.quads.rows()) - degenerate;
   const double gamma = MeanDihedralAngleDeg(X0, eq.quads, W);
   const double lambda = o.l0_lambda > 0 ? o.l0_lambda / (h * h) : o.l0_lambda_factor * gamma;
   result->l0_mean_dihedral_deg = gamma;

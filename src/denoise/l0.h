@@ -18,8 +18,27 @@
 #include <Eigen/Core>
 
 #include "denoise/denoiser.h"
+#include "denoise/lp_model.h"
 
 namespace mr {
+
+// The start that both edge-operator methods share (lp in denoiser.cc, l0
+// here): D's rows, and its weights on the mesh moved to its centroid and
+// scaled to unit mean edge length h.
+struct EdgeProblem {
+  EdgeQuads eq;
+  Eigen::RowVector3d centre;
+  double h = 0;
+  Eigen::MatrixXd X0;  // (V0 - centre) / h
+  Eigen::MatrixXd W;   // D's weights at X0
+  int degenerate = 0;  // rows of W left zero
+};
+// Fills result->num_skipped_edges and num_operator_rows. Where there is
+// nothing to denoise (no interior edge, or every edge of zero length) it
+// returns false with result->V = V0 and passed_through set, and logs why
+// under `label`.
+bool SetUpEdgeProblem(const Eigen::MatrixXd& V0, const Eigen::MatrixXi& F, const char* label,
+                      DenoiseResult* result, EdgeProblem* problem);
 
 // Runs the l0 method (options.method is not looked at; options are assumed
 // checked, input validated by mr::Denoise). Fills V, l0_lambda,
