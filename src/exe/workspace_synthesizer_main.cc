@@ -87,6 +87,9 @@ int main(int argc, char** argv) {
                 "Blinn-Phong exponent of the highlight (larger: sharper), [1, 10000]");
     options.Add("exposure_jitter", &o.exposure_jitter,
                 "standard deviation of the log of a random per-view exposure gain, [0, 1]");
+    options.Add("background", &o.background,
+                "grey level of a uniform backdrop behind the object, [0, 1] (radiance; 1 = "
+                "white); 0 = black");
     options.Add("vignetting", &o.vignetting,
                 "lens vignetting: the corners darkened by this share, 1 - v (r / r_corner)^2, "
                 "the same in every view, [0, 0.9]; 0 = none");

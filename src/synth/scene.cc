@@ -204,6 +204,17 @@ double ApplyExposureJitter(double sigma, uint32_t seed, uint32_t view_index, Syn
   return gain;
 }
 
+void ApplyBackground(double grey, SynthImage* image) {
+  MR_CHECK(image != nullptr);
+  MR_CHECK(grey >= 0 && grey <= 1) << "background " << grey;
+  MR_CHECK_EQ(image->radiance.size(), 3 * image->coverage.size());
+  if (grey == 0) return;
+  for (size_t pixel = 0; pixel < image->coverage.size(); ++pixel) {
+    const float add = static_cast<float>((1.0 - image->coverage[pixel]) * grey);
+    for (int c = 0; c < 3; ++c) image->radiance[3 * pixel + c] += add;
+  }
+}
+
 void ApplyVignetting(double strength, SynthImage* image) {
   MR_CHECK(image != nullptr);
   MR_CHECK(strength >= 0 && strength <= 0.9) << "vignetting strength " << strength;

@@ -98,6 +98,12 @@ void AddImageNoise(double sigma, uint32_t seed, uint32_t view_index, SynthImage*
 // (seed, view_index). sigma in [0, 1]; 0 leaves the image as it is (gain 1).
 double ApplyExposureJitter(double sigma, uint32_t seed, uint32_t view_index, SynthImage* image);
 
+// Puts the object in front of a uniform grey backdrop of radiance `grey`:
+// every pixel gets (1 - coverage) * grey added, so the anti-aliased outline
+// blends the two as a camera's pixel does. grey in [0, 1]; 0 leaves the
+// image as it is (a black background).
+void ApplyBackground(double grey, SynthImage* image);
+
 // Darkens the image towards its corners as a lens does (vignetting): every
 // channel of the pixel at distance r from the image centre is multiplied by
 // 1 - strength * (r / r_corner)^2, r_corner the distance to a corner, so the

@@ -332,6 +332,23 @@ TEST(ApplyVignetting, DarkensTowardsTheCornersQuadratically) {
   EXPECT_GT(value(1, 3, 0), value(1, 4, 0));
 }
 
+// The backdrop shows through in proportion to what the object leaves
+// uncovered: all of it on the background, none on the object, half on a
+// half-covered outline pixel.
+TEST(ApplyBackground, BlendsTheBackdropByCoverage) {
+  SynthImage image;
+  image.width = 3;
+  image.height = 1;
+  image.coverage = {0.f, 0.5f, 1.f};
+  image.radiance = {0, 0, 0, 0.2f, 0.3f, 0.4f, 0.6f, 0.7f, 0.8f};  // premultiplied by coverage
+  SynthImage black = image;
+  ApplyBackground(0, &black);
+  EXPECT_EQ(black.radiance, image.radiance);
+  ApplyBackground(0.5, &image);
+  const std::vector<float> expected = {0.5f, 0.5f, 0.5f, 0.45f, 0.55f, 0.65f, 0.6f, 0.7f, 0.8f};
+  for (int k = 0; k < 9; ++k) EXPECT_FLOAT_EQ(image.radiance[k], expected[k]) << k;
+}
+
 TEST(RenderDenseMaps, DepthPixelsBackProjectOntoSurfaceWithDenseConvention) {
   const SynthScene scene = CoarseScene();
   const std::vector<PinholeView> views = SmallRing(scene);

@@ -91,6 +91,10 @@ bool SynthesizerOptions::Check() const {
     MR_THROW_INPUT << "SynthesizerOptions::exposure_jitter = " << exposure_jitter
                    << ". Violated constraint: 0 <= exposure_jitter <= 1";
   }
+  if (!(background >= 0 && background <= 1)) {
+    MR_THROW_INPUT << "SynthesizerOptions::background = " << background
+                   << ". Violated constraint: 0 <= background <= 1";
+  }
   if (!(vignetting >= 0 && vignetting <= 0.9)) {
     MR_THROW_INPUT << "SynthesizerOptions::vignetting = " << vignetting
                    << ". Violated constraint: 0 <= vignetting <= 0.9";
@@ -224,6 +228,7 @@ SynthesizerSummary SynthesizeWorkspace(const SynthesizerOptions& options) {
         SynthViewName(static_cast<int>(i), options.jpeg_quality > 0 ? ".jpg" : ".png");
     names.push_back(name);
     SynthImage image = RenderImage(renderer, scene, views[i], options.supersample);
+    ApplyBackground(options.background, &image);
     ApplyVignetting(options.vignetting, &image);
     ApplyExposureJitter(options.exposure_jitter, static_cast<uint32_t>(options.seed),
                         static_cast<uint32_t>(i), &image);
@@ -259,8 +264,9 @@ SynthesizerSummary SynthesizeWorkspace(const SynthesizerOptions& options) {
                << options.cameras.height << ", supersample " << options.supersample
                << ", texture " << options.appearance.texture_style << ", light "
                << options.appearance.light << ", specular " << options.appearance.specular
-               << ", vignetting " << options.vignetting << ", exposure jitter "
-               << options.exposure_jitter << ", image noise " << options.image_noise
+               << ", background " << options.background << ", vignetting " << options.vignetting
+               << ", exposure jitter " << options.exposure_jitter << ", image noise "
+               << options.image_noise
                << (options.jpeg_quality > 0
                        ? ", JPEG quality " + std::to_string(options.jpeg_quality)
                        : std::string(", PNG"))

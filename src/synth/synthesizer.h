@@ -57,6 +57,9 @@ struct SynthesizerOptions {
   // and the view index) and clipped at 1, before the noise, as auto-exposure
   // varies between photos. 0 = every view exposed alike. Range [0, 1].
   double exposure_jitter = 0;
+  // Grey level of a uniform backdrop behind the object (ApplyBackground),
+  // before vignetting and exposure; 0 = black. Range [0, 1].
+  double background = 0;
   // Vignetting of the lens: radiance times 1 - vignetting * (r / r_corner)^2
   // (ApplyVignetting), before the exposure gain; the same in every view.
   // 0 = none. Range [0, 0.9].

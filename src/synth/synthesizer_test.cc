@@ -107,6 +107,9 @@ TEST(SynthesizerOptions, RejectsBadImageStyleAndCameraValues) {
   for (const double v : {-0.1, 0.95, std::nan("")}) {
     expect_message(rejects([v](SynthesizerOptions* o) { o->vignetting = v; }), "vignetting");
   }
+  for (const double g : {-0.1, 1.5, std::nan("")}) {
+    expect_message(rejects([g](SynthesizerOptions* o) { o->background = g; }), "background");
+  }
   for (const int q : {-1, 101}) {
     expect_message(rejects([q](SynthesizerOptions* o) { o->jpeg_quality = q; }), "jpeg_quality");
   }
