@@ -732,7 +732,12 @@ RefineSummary RefineMesh(const ViewSource& input_source, const RefineOptions& op
       masked = std::make_unique<MovedMaskViewSource>(working, mask_report.edge_offset_px);
     }
   }
-  const ViewSource& source = masked ? static_cast<const ViewSource&>(*masked) : working;
+  const ViewSource& masked_source = masked ? static_cast<const ViewSource&>(*masked) : working;
+  std::unique_ptr<BlackOutsideMasksViewSource> blackened;
+  if (working.HasMasks() && options.black_outside_masks) {
+    blackened = std::make_unique<BlackOutsideMasksViewSource>(masked_source);
+  }
+  const ViewSource& source = blackened ? *blackened : masked_source;
 
   RefineSummary summary;
   summary.masks = mask_report.views_measured > 0 ? mask_report.BriefReport() : "";
@@ -1275,6 +1280,13 @@ RefineSummary RefineMesh(const ViewSource& input_source, const RefineOptions& op
   summary.final_vertices = mesh->NumVertices();
   summary.termination = "FINISHED";
   summary.final_seconds = ElapsedSeconds() - t_final + early_final_seconds;
+  if (blackened) {
+    const std::string backdrop = blackened->Report();
+    if (!backdrop.empty()) {
+      MR_LOG(INFO) << "Backdrop: " << backdrop;
+      summary.masks += (summary.masks.empty() ? "" : "; ") + backdrop;
+    }
+  }
   summary.seconds = ElapsedSeconds() - t_start;
   return summary;
 }
@@ -1368,6 +1380,9 @@ void RegisterRefineOptions(OptionManager* o, RefineOptions* r) {
   o->Add("Refine.masks_from_background", &r->masks_from_background,
          "without masks, make them from a uniform background where they agree with the input "
          "mesh (for the silhouette term)");
+  o->Add("Refine.black_outside_masks", &r->black_outside_masks,
+         "with given masks, compare the images as if shot against black: every pixel outside "
+         "the mask set to 0");
   o->Add("Refine.align_masks", &r->align_masks,
          "with given masks, move their outlines onto the images' edges when these lie clearly "
          "off them (masks grown for a visual hull)");

@@ -711,6 +711,53 @@ TEST(ResizedViewSource, ImagesAndCamerasScaleTogether) {
   EXPECT_EQ(unlimited.LoadGray(0).cols, 401);
 }
 
+// Outside its mask every grey pixel becomes 0 where the backdrop is not dark;
+// inside, in a view without a mask, in a view on a dark backdrop, and in
+// the colour images, nothing changes.
+TEST(BlackOutsideMasksViewSource, BlackensWhatTheMaskLeavesOut) {
+  InMemoryViewSource base;
+  const PinholeView view = LookAtView(Eigen::Vector3d(0, -4, 0), Eigen::Vector3d::Zero(),
+                                      Eigen::Vector3d::UnitZ(), 40, 30, 50);
+  cv::Mat gray(30, 40, CV_32F), mask(30, 40, CV_8U, cv::Scalar(0));
+  cv::randu(gray, 0.1, 0.9);
+  mask(cv::Rect(5, 8, 20, 12)).setTo(255);
+  base.Add("masked", view, gray, mask);
+  base.Add("whole", view, gray, cv::Mat(30, 40, CV_8U, cv::Scalar(255)));
+  base.Add("none", view, gray);
+  cv::Mat dark = gray.clone();
+  dark.setTo(0.04, mask == 0);  // a backdrop of 10 grey levels
+  base.Add("dark", view, dark, mask);
+  EXPECT_NEAR(BackdropLevel(gray, mask), 0.5, 0.1);
+  EXPECT_FLOAT_EQ(BackdropLevel(dark, mask), 0.04f);
+  EXPECT_EQ(BackdropLevel(gray, cv::Mat(30, 40, CV_8U, cv::Scalar(255))), -1);
+  const BlackOutsideMasksViewSource black(base);
+  EXPECT_EQ(black.Report(), "");  // nothing loaded yet
+  const cv::Mat g = black.LoadGray(0);
+  ASSERT_EQ(g.size(), gray.size());
+  long kept = 0, blackened = 0;
+  for (int r = 0; r < 30; ++r) {
+    for (int c = 0; c < 40; ++c) {
+      if (mask.at<uint8_t>(r, c)) {
+        EXPECT_EQ(g.at<float>(r, c), gray.at<float>(r, c));
+        ++kept;
+      } else {
+        EXPECT_EQ(g.at<float>(r, c), 0.f);
+        ++blackened;
+      }
+    }
+  }
+  EXPECT_EQ(kept, 240);
+  EXPECT_EQ(blackened, 1200 - 240);
+  EXPECT_EQ(cv::norm(base.LoadGray(0), gray, cv::NORM_INF), 0);  // the base is untouched
+  EXPECT_EQ(cv::norm(black.LoadGray(1), gray, cv::NORM_INF), 0);
+  EXPECT_EQ(cv::norm(black.LoadGray(2), gray, cv::NORM_INF), 0);
+  EXPECT_EQ(cv::norm(black.LoadGray(3), dark, cv::NORM_INF), 0);
+  // The view whose mask covers it all has no backdrop to measure.
+  EXPECT_NE(black.Report().find("not dark in 1 of 2 views"), std::string::npos) << black.Report();
+  EXPECT_EQ(cv::norm(black.LoadColor(0), base.LoadColor(0), cv::NORM_INF), 0);
+  EXPECT_EQ(cv::norm(black.LoadMask(0), mask, cv::NORM_INF), 0);
+}
+
 // The schedule chooses itself: no coarse level for a start that is already
 // close (the truth), coarse levels for a far-off one (a sphere 12 % too big,
 // several pixels off in every view).
@@ -891,6 +938,50 @@ TEST_F(RefinerTest, GrownMasksAreMovedOntoTheImageEdges) {
             0.15 * (as_given.accuracy90 - as_exact.accuracy90));
   EXPECT_LT(moved.normal_deg - as_exact.normal_deg,
             0.15 * (as_given.normal_deg - as_exact.normal_deg));
+}
+
+// The bumpy sphere shot against black and against a grey backdrop, with exact
+// masks, refined from the smooth sphere: compared as if shot against black
+// (black_outside_masks, the default), the grey backdrop refines as the black
+// one does; compared as it is, its outline blends the object with grey in
+// each view, and the result is worse. Images on black are left as they are.
+TEST_F(RefinerTest, GreyBackdropRefinesAsBlackWithMasks) {
+  Eigen::MatrixXd V, V0;
+  Eigen::MatrixXi F, F0;
+  MakeBumpyAndSmoothSpheres(&V, &F, &V0, &F0);
+  auto scene = [&](double background) {
+    TestSceneOptions scene_options;
+    scene_options.background = background;
+    const InMemoryViewSource images = MakeTestScene(V, F, scene_options, {}, renderer_);
+    InMemoryViewSource masked;
+    for (int i = 0; i < images.NumViews(); ++i) {
+      masked.Add(images.Name(i), images.View(i), images.LoadGray(i),
+                 RenderedCoverage(renderer_->Render(images.View(i))));
+    }
+    return masked;
+  };
+  const InMemoryViewSource black = scene(0), grey = scene(0.6);
+  auto refine = [&](const InMemoryViewSource& source, bool black_outside) {
+    TriangleMesh mesh;
+    mesh.V = V0;
+    mesh.F = F0;
+    RefineOptions options = FastOptions();
+    options.black_outside_masks = black_outside;
+    RefineMesh(source, options, &mesh, renderer_);
+    const EvaluationResult result = Evaluate(mesh.V, mesh.F, V, F);
+    std::printf("%s backdrop, black_outside_masks %d: accuracy90 %.5f, normal %.2f deg\n",
+                &source == &black ? "black" : "grey", black_outside ? 1 : 0, result.accuracy90,
+                result.normal_deg);
+    return result;
+  };
+  const EvaluationResult on_black = refine(black, true);
+  const EvaluationResult on_black_as_is = refine(black, false);
+  EXPECT_EQ(on_black.accuracy90, on_black_as_is.accuracy90);
+  const EvaluationResult grey_as_black = refine(grey, true);
+  const EvaluationResult grey_as_is = refine(grey, false);
+  EXPECT_LT(grey_as_black.accuracy90, 1.05 * on_black.accuracy90);
+  EXPECT_LT(grey_as_black.normal_deg, 1.05 * on_black.normal_deg);
+  EXPECT_GT(grey_as_is.accuracy90, grey_as_black.accuracy90);
 }
 
 // The silhouette term's distances are searched near each contour vertex,

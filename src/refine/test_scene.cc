@@ -64,7 +64,7 @@ InMemoryViewSource MakeTestScene(const Eigen::MatrixXd& V, const Eigen::MatrixXi
     view.t = canonical.t * transform.scale - view.R * transform.translation;
     const PinholeView fine = view.Scaled(options.supersample);
     const RenderBuffers render = renderer->Render(fine);
-    cv::Mat hi(fine.height, fine.width, CV_32F, cv::Scalar(0));
+    cv::Mat hi(fine.height, fine.width, CV_32F, cv::Scalar(options.background));
     for (int r = 0; r < fine.height; ++r) {
       for (int col = 0; col < fine.width; ++col) {
         const int f = render.FaceAt(r, col);

@@ -34,6 +34,8 @@ struct TestSceneOptions {
   int supersample = 2;
   // Lit from each camera (a flash) instead of by a light fixed in the world.
   bool headlight = false;
+  // Grey level of the backdrop behind the object (0: black).
+  double background = 0;
 };
 
 // A closed bumpy sphere of radius ~1 (icosphere with radial relief

@@ -2,6 +2,9 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
+#include <sstream>
+#include <vector>
 
 #include <Eigen/Eigenvalues>
 #include <opencv2/imgproc.hpp>
@@ -211,6 +214,70 @@ cv::Mat ResizedViewSource::LoadMask(int i) const {
   cv::Mat binary;
   cv::threshold(Resize(i, mask), binary, 127, 255, cv::THRESH_BINARY);
   return binary;
+}
+
+double BackdropLevel(const cv::Mat& gray, const cv::Mat& mask) {
+  MR_CHECK(gray.type() == CV_32F && mask.type() == CV_8U && gray.size() == mask.size());
+  cv::Mat near, far;
+  cv::dilate(mask, near, cv::getStructuringElement(cv::MORPH_ELLIPSE, cv::Size(5, 5)));
+  cv::dilate(mask, far, cv::getStructuringElement(cv::MORPH_ELLIPSE, cv::Size(13, 13)));
+  std::vector<float> ring;
+  for (int r = 0; r < gray.rows; ++r) {
+    const uint8_t* n = near.ptr<uint8_t>(r);
+    const uint8_t* f = far.ptr<uint8_t>(r);
+    const float* g = gray.ptr<float>(r);
+    for (int c = 0; c < gray.cols; ++c) {
+      if (f[c] != 0 && n[c] == 0) ring.push_back(g[c]);
+    }
+  }
+  if (ring.empty()) return -1;
+  std::nth_element(ring.begin(), ring.begin() + ring.size() / 2, ring.end());
+  return ring[ring.size() / 2];
+}
+
+BlackOutsideMasksViewSource::BlackOutsideMasksViewSource(const ViewSource& base)
+    : DerivedViewSource(base),
+      levels_(base.NumViews(), std::numeric_limits<double>::quiet_NaN()) {}
+
+cv::Mat BlackOutsideMasksViewSource::LoadGray(int i) const {
+  cv::Mat gray = DerivedViewSource::LoadGray(i);
+  const cv::Mat mask = LoadMask(i);
+  if (mask.empty()) return gray;
+  MR_CHECK(mask.size() == gray.size()) << Name(i) << ": mask " << mask.cols << "x" << mask.rows
+                                       << ", image " << gray.cols << "x" << gray.rows;
+  const double backdrop = BackdropLevel(gray, mask);
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    levels_.at(i) = backdrop;
+  }
+  if (backdrop < kDarkBackdrop) return gray;  // already black (or nothing outside the mask)
+  gray = gray.clone();
+  gray.setTo(0, mask == 0);
+  return gray;
+}
+
+std::string BlackOutsideMasksViewSource::Report() const {
+  std::vector<double> levels;
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    for (const double level : levels_) {
+      if (level >= 0) levels.push_back(level);
+    }
+  }
+  if (levels.empty()) return "";
+  const long blackened = std::count_if(levels.begin(), levels.end(),
+                                       [](double level) { return level >= kDarkBackdrop; });
+  std::nth_element(levels.begin(), levels.begin() + levels.size() / 2, levels.end());
+  std::ostringstream out;
+  out << "the backdrop outside the masks has a median grey level of "
+      << levels[levels.size() / 2] << "; ";
+  if (blackened == 0) {
+    out << "dark in every view, the images are compared as they are";
+  } else {
+    out << "not dark in " << blackened << " of " << levels.size()
+        << " views, compared as if shot against black (Refine.black_outside_masks)";
+  }
+  return out.str();
 }
 
 }  // namespace mr

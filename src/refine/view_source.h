@@ -7,6 +7,7 @@
 #include <list>
 #include <map>
 #include <memory>
+#include <mutex>
 #include <set>
 #include <string>
 #include <vector>
@@ -124,6 +125,34 @@ std::vector<int> EvenlySpacedViews(int num_views, int max_views);
 // more than in brightness it follows the hue.
 Eigen::Vector3d PrincipalTextureColor(const ViewSource& source, int max_images = 16,
                                       double sigma_px = 4.0);
+
+// The grey images with every pixel outside the view's mask set to 0, as if
+// the object had been shot against black, where the backdrop is not dark
+// already (BackdropLevel at least kDarkBackdrop); views without a mask, views
+// shot on a dark backdrop, and the colour images are left as they are. The
+// masks are taken as exact: on a grey backdrop the outline blends the
+// object with grey, which the other views do not show there; on black the
+// blend is the object's own colour scaled by its coverage, and leaving it
+// keeps the outline's anti-aliasing (docs/results.md).
+class BlackOutsideMasksViewSource : public DerivedViewSource {
+ public:
+  explicit BlackOutsideMasksViewSource(const ViewSource& base);
+  cv::Mat LoadGray(int i) const override;
+  // Of the views loaded so far: how many were blackened, out of how many
+  // with a mask, and their median backdrop level; "" if none had a mask.
+  std::string Report() const;
+
+ private:
+  mutable std::mutex mutex_;
+  mutable std::vector<double> levels_;  // BackdropLevel per view; NaN: not loaded or no mask
+};
+
+// The median grey level of the ring of pixels 3 to 6 px outside a mask
+// (CV_32F image in [0, 1], CV_8U mask, nonzero = object): what the object
+// stands against. -1 where the ring is empty (the mask covers the image).
+double BackdropLevel(const cv::Mat& gray, const cv::Mat& mask);
+// A backdrop darker than this (about 13 of 255 grey levels) counts as black.
+constexpr double kDarkBackdrop = 0.05;
 
 // Views and images held in memory (tests, synthetic scenes).
 class InMemoryViewSource : public ViewSource {
