@@ -216,11 +216,13 @@ struct RefineOptions {
   // silhouette term (mask_outline.h). The corpus's exact masks measure
   // within half a pixel and are used as given (docs/results.md).
   bool align_masks = true;
-  // With given masks: compare the images with every pixel outside the mask
-  // set to black (BlackOutsideMasksViewSource), whatever the backdrop. On a
-  // grey backdrop, accuracy90 is then within 4 % of the same scene shot on
-  // black, against 14 % worse as it is (docs/results.md). Masks made from
-  // the background are not exact enough for this and are not used so.
+  // With given masks: compare the images of every view whose backdrop is not
+  // dark already with the pixels outside its mask set to black
+  // (BlackOutsideMasksViewSource). On a grey backdrop, accuracy90 is then
+  // within 4 % of the same scene shot on black, against 14 % worse as it is;
+  // views on black keep their outline's anti-aliasing (docs/results.md).
+  // Masks made from the background are not exact enough for this and are
+  // not used so.
   bool black_outside_masks = true;
   MaskOutlineOptions mask_outline;
   // Check every iteration for faces that the step made intersect and move

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <iomanip>
 #include <limits>
 #include <sstream>
 #include <vector>
@@ -269,8 +270,8 @@ std::string BlackOutsideMasksViewSource::Report() const {
                                        [](double level) { return level >= kDarkBackdrop; });
   std::nth_element(levels.begin(), levels.begin() + levels.size() / 2, levels.end());
   std::ostringstream out;
-  out << "the backdrop outside the masks has a median grey level of "
-      << levels[levels.size() / 2] << "; ";
+  out << "the backdrop outside the masks has a median grey level of " << std::fixed
+      << std::setprecision(3) << levels[levels.size() / 2] << "; ";
   if (blackened == 0) {
     out << "dark in every view, the images are compared as they are";
   } else {
