@@ -1381,8 +1381,8 @@ void RegisterRefineOptions(OptionManager* o, RefineOptions* r) {
          "without masks, make them from a uniform background where they agree with the input "
          "mesh (for the silhouette term)");
   o->Add("Refine.black_outside_masks", &r->black_outside_masks,
-         "with given masks, compare the images as if shot against black: every pixel outside "
-         "the mask set to 0");
+         "with given masks, compare the images as if shot against black: in every view whose "
+         "backdrop is not dark already, every pixel outside the mask set to 0");
   o->Add("Refine.align_masks", &r->align_masks,
          "with given masks, move their outlines onto the images' edges when these lie clearly "
          "off them (masks grown for a visual hull)");

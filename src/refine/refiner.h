@@ -316,7 +316,8 @@ struct RefineSummary {
   std::string termination;  // "FINISHED" or why it stopped
   std::string schedule;     // num_levels 0: what was chosen and why
   std::string light;        // where the light was taken to be, and why
-  std::string masks;        // given masks: where their outlines lie (align_masks)
+  std::string masks;        // given masks: where their outlines lie (align_masks), and
+                            // their backdrop (black_outside_masks)
   int num_views = 0;
   int num_pairs = 0;
   int initial_faces = 0, final_faces = 0;
