@@ -7,6 +7,8 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <cstdint>
+#include <cstring>
 #include <exception>
 #include <iterator>
 #include <map>
@@ -39,6 +41,7 @@
 #include "geometry/mesh.h"
 #include "geometry/self_intersection.h"
 #include "util/error.h"
+#include "util/isolated.h"
 #include "util/logging.h"
 
 namespace mr {
@@ -530,15 +533,56 @@ std::string IsotropicRemeshSummary::BriefReport() const {
   s << "target edge " << target_edge_length << ": faces " << initial_faces << " -> "
     << final_faces << ", vertices " << initial_vertices << " -> " << final_vertices
     << ", mean edge " << initial_mean_edge_length << " -> " << final_mean_edge_length << ", "
-    << protected_edges << " protected edges, " << seconds << " s";
+    << protected_edges << " protected edges, "
+    << (relaxation_dropped ? "without relaxation (CGAL's crashed), " : "") << seconds << " s";
   return s.str();
 }
 
 namespace {
 
+// (V, F) and a count as bytes, and back: RemeshIsotropically's child process
+// answers with them.
+std::string PackMesh(const Eigen::MatrixXd& V, const Eigen::MatrixXi& F, int count) {
+  const int64_t rows[2] = {V.rows(), F.rows()};
+  const Eigen::Matrix<double, Eigen::Dynamic, 3, Eigen::RowMajor> v = V;
+  const Eigen::Matrix<int, Eigen::Dynamic, 3, Eigen::RowMajor> f = F;
+  std::string out(reinterpret_cast<const char*>(rows), sizeof rows);
+  out.append(reinterpret_cast<const char*>(v.data()), sizeof(double) * v.size());
+  out.append(reinterpret_cast<const char*>(f.data()), sizeof(int) * f.size());
+  out.append(reinterpret_cast<const char*>(&count), sizeof count);
+  return out;
+}
+
+void UnpackMesh(const std::string& bytes, Eigen::MatrixXd* V, Eigen::MatrixXi* F, int* count) {
+  int64_t rows[2];
+  MR_CHECK_GE(bytes.size(), sizeof rows);
+  std::memcpy(rows, bytes.data(), sizeof rows);
+  MR_CHECK_EQ(bytes.size(), sizeof rows + sizeof(double) * 3 * rows[0] +
+                                 sizeof(int) * 3 * rows[1] + sizeof(int));
+  Eigen::Matrix<double, Eigen::Dynamic, 3, Eigen::RowMajor> v(rows[0], 3);
+  Eigen::Matrix<int, Eigen::Dynamic, 3, Eigen::RowMajor> f(rows[1], 3);
+  const char* at = bytes.data() + sizeof rows;
+  std::memcpy(v.data(), at, sizeof(double) * v.size());
+  at += sizeof(double) * v.size();
+  std::memcpy(f.data(), at, sizeof(int) * f.size());
+  at += sizeof(int) * f.size();
+  std::memcpy(count, at, sizeof(int));
+  *V = v;
+  *F = f;
+}
+
 // The isotropic remeshing of IsotropicRemesh and IsotropicRemeshBands:
-// `passes` gets the CGAL mesh, the constrained-edge map and whether any edge
-// is protected, and runs CGAL's remeshing on it.
+// `passes` gets the CGAL mesh, the constrained-edge map, whether any edge
+// is protected and the relaxation steps per round, and runs CGAL's
+// remeshing on it.
+//
+// CGAL 5.5's tangential relaxation (Debian 12's) reads through a null
+// halfedge when every face around a vertex it has just moved is degenerate,
+// and the process ends with a segmentation fault: a closed bipyramid on
+// three collinear vertices does it (IsotropicRemesh.SurvivesCgalsRelaxationCrash),
+// and so did a refinement of a tangled Poisson blob between two pyramid
+// levels. So the remeshing runs in a child process (RunIsolated); if that
+// crashes, it runs again here without relaxation, which cannot.
 template <typename Passes>
 IsotropicRemeshSummary RemeshIsotropically(const char* what, Eigen::MatrixXd* V,
                                            Eigen::MatrixXi* F, double shortest_edge,
@@ -554,40 +598,64 @@ IsotropicRemeshSummary RemeshIsotropically(const char* what, Eigen::MatrixXd* V,
   summary.initial_faces = summary.final_faces = F->rows();
   summary.initial_mean_edge_length = summary.final_mean_edge_length = MeanEdgeLength(*V, *F);
   if (F->rows() == 0) return summary;
-  Mesh mesh = ToCgal(*V, *F, what);
-  RunCgal(what, [&] {
-    auto constrained = mesh.add_property_map<Mesh::Edge_index, bool>("e:mr_constrained", false).first;
-    if (options.protect_border) {
-      for (Mesh::Edge_index e : mesh.edges()) {
-        if (mesh.is_border(e)) constrained[e] = true;
+  // The remeshed (V, F) and the number of protected edges.
+  auto remesh = [&](int relaxation_steps, Eigen::MatrixXd* V_out, Eigen::MatrixXi* F_out) {
+    Mesh mesh = ToCgal(*V, *F, what);
+    int protected_edges = 0;
+    RunCgal(what, [&] {
+      auto constrained =
+          mesh.add_property_map<Mesh::Edge_index, bool>("e:mr_constrained", false).first;
+      if (options.protect_border) {
+        for (Mesh::Edge_index e : mesh.edges()) {
+          if (mesh.is_border(e)) constrained[e] = true;
+        }
       }
-    }
-    if (options.protect_sharp_edges) {
-      auto sharp = mesh.add_property_map<Mesh::Edge_index, bool>("e:mr_sharp", false).first;
-      PMP::detect_sharp_edges(mesh, options.sharp_angle_deg, sharp);
-      for (Mesh::Edge_index e : mesh.edges()) {
-        if (sharp[e]) constrained[e] = true;
+      if (options.protect_sharp_edges) {
+        auto sharp = mesh.add_property_map<Mesh::Edge_index, bool>("e:mr_sharp", false).first;
+        PMP::detect_sharp_edges(mesh, options.sharp_angle_deg, sharp);
+        for (Mesh::Edge_index e : mesh.edges()) {
+          if (sharp[e]) constrained[e] = true;
+        }
+        mesh.remove_property_map(sharp);
       }
-      mesh.remove_property_map(sharp);
-    }
-    std::vector<Mesh::Edge_index> protected_edges;
-    for (Mesh::Edge_index e : mesh.edges()) {
-      if (constrained[e]) protected_edges.push_back(e);
-    }
-    const bool protect = !protected_edges.empty();
-    if (protect) {
-      // CGAL can only protect edges <= 4/3 of the target: split them first
-      // (the pieces stay constrained).
-      PMP::split_long_edges(protected_edges, shortest_edge, mesh,
-                            CGAL::parameters::edge_is_constrained_map(constrained));
-      summary.protected_edges = 0;
-      for (Mesh::Edge_index e : mesh.edges()) summary.protected_edges += constrained[e] ? 1 : 0;
-    }
-    passes(mesh, constrained, protect);
-    mesh.remove_property_map(constrained);
+      std::vector<Mesh::Edge_index> protected_list;
+      for (Mesh::Edge_index e : mesh.edges()) {
+        if (constrained[e]) protected_list.push_back(e);
+      }
+      const bool protect = !protected_list.empty();
+      if (protect) {
+        // CGAL can only protect edges <= 4/3 of the target: split them first
+        // (the pieces stay constrained).
+        PMP::split_long_edges(protected_list, shortest_edge, mesh,
+                              CGAL::parameters::edge_is_constrained_map(constrained));
+        for (Mesh::Edge_index e : mesh.edges()) protected_edges += constrained[e] ? 1 : 0;
+      }
+      passes(mesh, constrained, protect, relaxation_steps);
+      mesh.remove_property_map(constrained);
+    });
+    mesh.collect_garbage();
+    FromCgal(mesh, V_out, F_out);
+    return protected_edges;
+  };
+  Eigen::MatrixXd V_new;
+  Eigen::MatrixXi F_new;
+  const IsolatedResult isolated = RunIsolated([&] {
+    Eigen::MatrixXd V_child;
+    Eigen::MatrixXi F_child;
+    const int protected_edges = remesh(options.relaxation_steps, &V_child, &F_child);
+    return PackMesh(V_child, F_child, protected_edges);
   });
-  mesh.collect_garbage();
-  FromCgal(mesh, V, F);
+  if (isolated.status == IsolatedResult::Status::kDone) {
+    UnpackMesh(isolated.payload, &V_new, &F_new, &summary.protected_edges);
+  } else {
+    MR_LOG(WARNING) << what << ": CGAL's remeshing crashed (signal " << isolated.signal
+                    << "; CGAL 5.5's tangential relaxation on a vertex whose faces all became "
+                       "degenerate); remeshing again without relaxation";
+    summary.protected_edges = remesh(0, &V_new, &F_new);
+    summary.relaxation_dropped = true;
+  }
+  *V = std::move(V_new);
+  *F = std::move(F_new);
   summary.final_vertices = V->rows();
   summary.final_faces = F->rows();
   summary.final_mean_edge_length = MeanEdgeLength(*V, *F);
@@ -610,10 +678,10 @@ IsotropicRemeshSummary IsotropicRemesh(Eigen::MatrixXd* V, Eigen::MatrixXi* F,
   CheckEdgeLength("IsotropicRemesh", target_edge_length);
   const IsotropicRemeshSummary summary = RemeshIsotropically(
       "IsotropicRemesh", V, F, target_edge_length, options,
-      [&](Mesh& mesh, auto& constrained, bool protect) {
+      [&](Mesh& mesh, auto& constrained, bool protect, int relaxation_steps) {
         PMP::isotropic_remeshing(faces(mesh), target_edge_length, mesh,
                                  CGAL::parameters::number_of_iterations(options.iterations)
-                                     .number_of_relaxation_steps(options.relaxation_steps)
+                                     .number_of_relaxation_steps(relaxation_steps)
                                      .protect_constraints(protect)
                                      .edge_is_constrained_map(constrained));
       });
@@ -635,7 +703,7 @@ IsotropicRemeshSummary IsotropicRemeshBands(Eigen::MatrixXd* V, Eigen::MatrixXi*
   std::ostringstream passes_report;
   const IsotropicRemeshSummary summary = RemeshIsotropically(
       "IsotropicRemeshBands", V, F, shortest, options,
-      [&](Mesh& mesh, auto& constrained, bool protect) {
+      [&](Mesh& mesh, auto& constrained, bool protect, int relaxation_steps) {
         for (const int band : order) {
           std::vector<Mesh::Face_index> patch;
           for (Mesh::Face_index f : mesh.faces()) {
@@ -658,7 +726,7 @@ IsotropicRemeshSummary IsotropicRemeshBands(Eigen::MatrixXd* V, Eigen::MatrixXi*
           if (patch.empty()) continue;
           PMP::isotropic_remeshing(patch, band_edges[band], mesh,
                                    CGAL::parameters::number_of_iterations(options.iterations)
-                                       .number_of_relaxation_steps(options.relaxation_steps)
+                                       .number_of_relaxation_steps(relaxation_steps)
                                        .protect_constraints(protect)
                                        .edge_is_constrained_map(constrained));
         }

@@ -132,6 +132,9 @@ struct IsotropicRemeshSummary {
   double target_edge_length = 0;
   double initial_mean_edge_length = 0, final_mean_edge_length = 0;
   int protected_edges = 0;  // border + sharp edges kept
+  // CGAL's relaxation crashed and the remeshing ran again without it
+  // (RemeshIsotropically in remesh.cc).
+  bool relaxation_dropped = false;
   double seconds = 0;
   std::string BriefReport() const;
 };

@@ -327,6 +327,39 @@ TEST(IsotropicRemesh, SphereReachesTargetEdgeLength) {
   EXPECT_LT(MaxRadiusError(V), 0.02);
 }
 
+// A closed bipyramid over three collinear vertices a, c, b (no face is
+// degenerate): relaxing its apex moves it onto the line, every face around
+// it becomes degenerate, and CGAL 5.5's tangential relaxation reads through a
+// null halfedge (a segmentation fault). The remeshing runs in a child
+// process and, when that crashes, again without relaxation.
+TEST(IsotropicRemesh, SurvivesCgalsRelaxationCrash) {
+  Eigen::MatrixXd V(5, 3);
+  V << 0, 0, 0,  // a
+      2, 0, 0,   // b
+      1, 0, 0,   // c, between them
+      1, 1, 1,   // apex above
+      1, -1, 1;  // apex below
+  Eigen::MatrixXi F(6, 3);
+  F << 0, 2, 3, 2, 1, 3, 1, 0, 3, 4, 2, 0, 4, 1, 2, 4, 0, 1;
+  ASSERT_TRUE(IsClosedManifold(V, F));
+  for (const double target : {0.5, 1.0}) {
+    Eigen::MatrixXd V_out = V;
+    Eigen::MatrixXi F_out = F;
+    const IsotropicRemeshSummary s = IsotropicRemesh(&V_out, &F_out, target);
+    EXPECT_TRUE(s.relaxation_dropped) << target;
+    EXPECT_GT(F_out.rows(), 0) << target;
+    EXPECT_TRUE(V_out.allFinite()) << target;
+  }
+  // A mesh CGAL's relaxation handles keeps it, and ends as remeshed in the
+  // calling process (the child's answer is the mesh, bit for bit).
+  Eigen::MatrixXd S;
+  Eigen::MatrixXi T;
+  Icosphere(3, &S, &T);
+  const IsotropicRemeshSummary s = IsotropicRemesh(&S, &T, 0.15);
+  EXPECT_FALSE(s.relaxation_dropped);
+  EXPECT_TRUE(IsClosedManifold(S, T));
+}
+
 TEST(IsotropicRemesh, ProtectedBorderStaysOnInputBorder) {
   Eigen::MatrixXd V;
   Eigen::MatrixXi F;

@@ -15,6 +15,7 @@
 #include "util/error.h"
 #include "util/file.h"
 #include "util/interrupt.h"
+#include "util/isolated.h"
 #include "util/statistics.h"
 #include "util/testing.h"
 #include "util/options.h"
@@ -337,6 +338,43 @@ TEST(Statistics, AgreesWithSorting) {
     copy = values;
     EXPECT_THROW(NthSmallest(&copy, n), InternalError);
   }
+}
+
+// RunIsolated: what the child returns arrives (large answers too: more than
+// the pipe holds); a child that dies is reported with its signal; the
+// errors it throws are thrown again in the caller.
+TEST(RunIsolated, ReturnsReportsCrashesAndRethrows) {
+  const IsolatedResult small = RunIsolated([] { return std::string("remeshed"); });
+  EXPECT_EQ(small.status, IsolatedResult::Status::kDone);
+  EXPECT_EQ(small.payload, "remeshed");
+  std::string large(3 << 20, 'x');
+  large[12345] = 'y';
+  const IsolatedResult big = RunIsolated([&] { return large; });
+  EXPECT_EQ(big.status, IsolatedResult::Status::kDone);
+  EXPECT_EQ(big.payload, large);
+  // (SIGKILL: a sanitizer turns a segmentation fault into an exit status.)
+  const IsolatedResult crashed = RunIsolated([]() -> std::string {
+    raise(SIGKILL);
+    return "never";
+  });
+  EXPECT_EQ(crashed.status, IsolatedResult::Status::kCrashed);
+  EXPECT_EQ(crashed.signal, SIGKILL);
+  EXPECT_TRUE(crashed.payload.empty());
+  try {
+    RunIsolated([]() -> std::string { throw InputError("bad mesh"); });
+    ADD_FAILURE() << "no InputError";
+  } catch (const InputError& e) {
+    EXPECT_STREQ(e.what(), "bad mesh");
+  }
+  EXPECT_THROW(RunIsolated([]() -> std::string { throw std::runtime_error("oops"); }),
+               InternalError);
+  // The child's changes to memory stay in the child.
+  int touched = 0;
+  RunIsolated([&] {
+    touched = 1;
+    return std::string();
+  });
+  EXPECT_EQ(touched, 0);
 }
 
 }  // namespace
