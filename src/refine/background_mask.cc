@@ -34,6 +34,9 @@ bool BackgroundMaskOptions::Check() const {
   if (!(min_agreement >= 0 && min_agreement <= 1)) {
     fail("min_agreement", min_agreement, "0 <= min_agreement <= 1");
   }
+  if (!(min_clear_outline >= 0 && min_clear_outline <= 1)) {
+    fail("min_clear_outline", min_clear_outline, "0 <= min_clear_outline <= 1");
+  }
   if (min_object_px < 0) fail("min_object_px", min_object_px, "min_object_px >= 0");
   if (!(max_offset >= 0 && max_offset <= 1)) fail("max_offset", max_offset, "0 <= max_offset <= 1");
   if (!(min_support >= 0 && min_support <= 1)) fail("min_support", min_support, "0 <= min_support <= 1");
@@ -173,6 +176,50 @@ cv::Mat MaskOfFiltered(const cv::Mat& filtered, const BackgroundModel& model,
   return mask;
 }
 
+// `mask` with its holes filled: everything but the background connected to
+// the image border (4-connected, as MaskOfFiltered's background).
+cv::Mat WithoutHoles(const cv::Mat& mask) {
+  cv::Mat labels;
+  const std::vector<uchar> outside =
+      SelectComponents(mask == 0, 4, [](bool touches, int) { return touches; }, &labels);
+  cv::Mat filled(mask.size(), CV_8U);
+  for (int r = 0; r < mask.rows; ++r) {
+    const int* l = labels.ptr<int>(r);
+    uchar* f = filled.ptr<uchar>(r);
+    for (int c = 0; c < mask.cols; ++c) f[c] = outside[l[c]] ? 0 : 255;
+  }
+  return filled;
+}
+
+double ClearShareOfFiltered(const cv::Mat& filtered, const cv::Mat& mask,
+                            const BackgroundModel& model, const BackgroundMaskOptions& options) {
+  MR_CHECK(mask.size() == filtered.size() && mask.type() == CV_8U);
+  const int rows = mask.rows, cols = mask.cols;
+  auto inside = [&](int r, int c) { return mask.at<uchar>(r, c) != 0; };
+  const double clear = options.witness_tolerances * model.tolerance;
+  long outline = 0, clear_outline = 0;
+  for (int r = 0; r < rows; ++r) {
+    for (int c = 0; c < cols; ++c) {
+      if (!inside(r, c)) continue;
+      const bool on_outline = (r > 0 && !inside(r - 1, c)) || (r + 1 < rows && !inside(r + 1, c)) ||
+                              (c > 0 && !inside(r, c - 1)) || (c + 1 < cols && !inside(r, c + 1));
+      if (!on_outline) continue;
+      double sum = 0;  // over the object pixels of the 5x5 window
+      int count = 0;
+      for (int rr = std::max(0, r - 2); rr <= std::min(rows - 1, r + 2); ++rr) {
+        for (int cc = std::max(0, c - 2); cc <= std::min(cols - 1, c + 2); ++cc) {
+          if (!inside(rr, cc)) continue;
+          sum += ColorDistance(filtered.at<cv::Vec3b>(rr, cc), model.color);
+          ++count;
+        }
+      }
+      ++outline;
+      clear_outline += sum >= clear * count ? 1 : 0;
+    }
+  }
+  return outline == 0 ? 1.0 : static_cast<double>(clear_outline) / outline;
+}
+
 }  // namespace
 
 BackgroundModel EstimateBackground(const cv::Mat& image, const BackgroundMaskOptions& options) {
@@ -183,6 +230,11 @@ BackgroundModel EstimateBackground(const cv::Mat& image, const BackgroundMaskOpt
 cv::Mat BackgroundMask(const cv::Mat& image, const BackgroundModel& model,
                        const BackgroundMaskOptions& options) {
   return MaskOfFiltered(Smoothed(image), model, options);
+}
+
+double ClearOutlineShare(const cv::Mat& image, const cv::Mat& mask, const BackgroundModel& model,
+                         const BackgroundMaskOptions& options) {
+  return ClearShareOfFiltered(Smoothed(image), mask, model, options);
 }
 
 double MaskAgreement(const cv::Mat& a, const cv::Mat& b) {
@@ -225,20 +277,30 @@ cv::Mat LimitToOutlineBand(const cv::Mat& mask, const cv::Mat& covered, double m
 }
 
 std::string BackgroundMaskReport::BriefReport() const {
-  std::vector<double> accepted;
-  for (double a : agreement) {
-    if (a >= 0) accepted.push_back(a);
-  }
+  // The per-view figures of the views with a uniform background, sorted.
+  auto of_uniform = [](const std::vector<double>& per_view) {
+    std::vector<double> values;
+    for (double v : per_view) {
+      if (v >= 0) values.push_back(v);
+    }
+    std::sort(values.begin(), values.end());
+    return values;
+  };
+  const std::vector<double> accepted = of_uniform(agreement), clear = of_uniform(clear_share);
   std::ostringstream out;
   out.precision(3);
-  out << num_uniform << " of " << num_views << " views have a uniform background; "
-      << num_accepted << " agree with the input mesh and get masks";
+  out << num_uniform << " of " << num_views << " views have a uniform background; " << num_clear
+      << " of these a clear outline";
+  if (!clear.empty()) {
+    out << " (share of the outline clearly unlike the background: min " << clear.front()
+        << ", median " << clear[clear.size() / 2] << ")";
+  }
+  out << "; " << num_accepted << " of those agree with the input mesh and get masks";
   if (num_removals > 0) {
     out << "; " << num_confirmed << " of " << num_removals
         << " pixels they take from the mesh are confirmed by other views";
   }
   if (!accepted.empty()) {
-    std::sort(accepted.begin(), accepted.end());
     out << " (mask vs rendered mesh, intersection over union: min " << accepted.front()
         << ", median " << accepted[accepted.size() / 2] << ")";
   }
@@ -275,6 +337,7 @@ std::unique_ptr<BackgroundMaskedViewSource> MakeBackgroundMasks(
   BackgroundMaskReport local;
   local.num_views = n;
   local.agreement.assign(n, -1.0);
+  local.clear_share.assign(n, -1.0);
   std::vector<BackgroundModel> models(n);
   std::vector<std::vector<uchar>> encoded(n);
   std::vector<std::vector<Removal>> removals(n);
@@ -296,13 +359,20 @@ std::unique_ptr<BackgroundMaskedViewSource> MakeBackgroundMasks(
     const cv::Mat mask = MaskOfFiltered(filtered, model, options);
     const RenderBuffers render = renderer->Render(view);
     const cv::Mat covered = RenderedCoverage(render);
-    local.agreement[i] = MaskAgreement(mask, covered);
-    const bool accepted = local.agreement[i] >= options.min_agreement;
+    // The outer outlines are compared: a hole of the mask is checked pixel by
+    // pixel below (the band and the other views), and on a backdrop that
+    // is not black every patch of the texture with its colour is one.
+    local.agreement[i] = MaskAgreement(WithoutHoles(mask), WithoutHoles(covered));
+    local.clear_share[i] = ClearShareOfFiltered(filtered, mask, model, options);
+    const bool clear = local.clear_share[i] >= options.min_clear_outline;
+    const bool accepted = clear && local.agreement[i] >= options.min_agreement;
     MR_LOG(VERBOSE) << source.Name(i) << ": background (B, G, R) = (" << model.color[0] << ", "
                     << model.color[1] << ", " << model.color[2] << "), spread " << model.spread
                     << ", " << 100 * model.border_share << " % of the border within "
-                    << model.tolerance << "; mask vs rendered mesh " << local.agreement[i]
+                    << model.tolerance << "; outline clear " << local.clear_share[i]
+                    << ", mask vs rendered mesh " << local.agreement[i]
                     << (accepted ? "" : ": no mask");
+    local.num_clear += clear ? 1 : 0;
     if (!accepted) continue;
     ++local.num_accepted;
     const double max_offset_px = options.max_offset * std::max(view.width, view.height);

@@ -2,6 +2,7 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <random>
 
@@ -52,7 +53,7 @@ TEST(BackgroundMaskTest, UniformNoisyBackgroundGivesTheObject) {
   }
 }
 
-TEST(BackgroundMaskTest, HolesSmallAreFilledLargeAreBackground) {
+TEST(BackgroundMaskTest, EnclosedBackgroundIsAHoleUnlessTooSmall) {
   BackgroundMaskOptions options;
   cv::Mat truth;
   cv::Mat image = DiscImage({0, 0, 0}, 2.0, &truth);
@@ -63,12 +64,18 @@ TEST(BackgroundMaskTest, HolesSmallAreFilledLargeAreBackground) {
   truth(cv::Rect(170, 110, 30, 30)).setTo(0);
   const BackgroundModel model = EstimateBackground(image, options);
   ASSERT_TRUE(model.uniform);
+  // By default every enclosed region of the background's colour is a hole;
+  // MakeBackgroundMasks keeps it only near the mesh's outline and where
+  // other views confirm it.
   const cv::Mat mask = BackgroundMask(image, model, options);
-  EXPECT_EQ(mask.at<uchar>(104, 134), 255);  // the spot is object
-  EXPECT_EQ(mask.at<uchar>(125, 185), 0);    // the hole is background
-  EXPECT_GT(MaskAgreement(mask, truth), 0.99);
-  options.min_hole_share = 0.0;  // every enclosed region is background
-  EXPECT_EQ(BackgroundMask(image, model, options).at<uchar>(104, 134), 0);
+  EXPECT_EQ(mask.at<uchar>(104, 134), 0);
+  EXPECT_EQ(mask.at<uchar>(125, 185), 0);
+  // With a least share, the spot is object and the hole background.
+  options.min_hole_share = 0.002;
+  const cv::Mat large_holes = BackgroundMask(image, model, options);
+  EXPECT_EQ(large_holes.at<uchar>(104, 134), 255);
+  EXPECT_EQ(large_holes.at<uchar>(125, 185), 0);
+  EXPECT_GT(MaskAgreement(large_holes, truth), 0.99);
 }
 
 TEST(BackgroundMaskTest, TexturedOrPartlyCoveredBorderIsNotUniform) {
@@ -83,6 +90,39 @@ TEST(BackgroundMaskTest, TexturedOrPartlyCoveredBorderIsNotUniform) {
   const BackgroundModel model = EstimateBackground(image, options);
   EXPECT_LT(model.border_share, 0.9);
   EXPECT_FALSE(model.uniform);
+}
+
+// A grey disc whose texture swings about the backdrop's grey has an outline
+// that follows the texture, and is not clear; the same disc lifted well
+// above the backdrop, or on black, is.
+TEST(BackgroundMaskTest, AnOutlineIsClearWhereTheObjectIsUnlikeTheBackground) {
+  const BackgroundMaskOptions options;
+  auto disc = [](double backdrop, double level, double swing) {
+    cv::Mat image(240, 320, CV_8UC3, cv::Scalar::all(backdrop));
+    for (int r = 0; r < image.rows; ++r) {
+      for (int c = 0; c < image.cols; ++c) {
+        if (std::hypot(c - 160, r - 120) > 60) continue;
+        image.at<cv::Vec3b>(r, c) =
+            cv::Vec3b::all(cv::saturate_cast<uchar>(level + swing * std::sin(0.15 * c + 0.1 * r)));
+      }
+    }
+    return image;
+  };
+  auto share = [&](const cv::Mat& image) {
+    const BackgroundModel model = EstimateBackground(image, options);
+    EXPECT_TRUE(model.uniform);
+    return ClearOutlineShare(image, BackgroundMask(image, model, options), model, options);
+  };
+  const double tolerance = options.min_tolerance;  // no noise: the least tolerance
+  // About the backdrop: within 3 tolerances of it on 70 % of the outline.
+  EXPECT_LT(share(disc(120, 120, 1.5 * options.witness_tolerances * tolerance)), 0.5);
+  EXPECT_EQ(share(disc(120, 200, 20)), 1.0);
+  EXPECT_EQ(share(disc(0, 120, 60)), 1.0);
+  // A mask with no outline is clear.
+  const cv::Mat blank(240, 320, CV_8UC3, cv::Scalar::all(50));
+  EXPECT_EQ(ClearOutlineShare(blank, cv::Mat::zeros(blank.size(), CV_8U),
+                              EstimateBackground(blank, options), options),
+            1.0);
 }
 
 // The mask moves the outline of `covered` by at most max_offset_px: a disc
@@ -121,6 +161,9 @@ TEST(BackgroundMaskTest, OptionsAreChecked) {
   EXPECT_THROW(options.Check(), InputError);
   options = {};
   options.witness_tolerances = 0.5;
+  EXPECT_THROW(options.Check(), InputError);
+  options = {};
+  options.min_clear_outline = 1.1;
   EXPECT_THROW(options.Check(), InputError);
 }
 
@@ -171,6 +214,44 @@ TEST(BackgroundMaskTest, MasksAreKeptWhereTheyAgreeWithTheMesh) {
     const cv::Mat truth = coverage(V, i), mask = corrected->LoadMask(i);
     EXPECT_LT(MaskAgreement(coverage(bulge, i), truth), 0.96) << i;
     EXPECT_GT(MaskAgreement(mask, truth), 0.97) << i;
+  }
+}
+
+// The refiner's test scene on a backdrop of its texture's darker greys: the
+// made masks' outlines follow the texture (clear on 47-69 % of their length),
+// and no view gets a mask; on black every outline is clear and every view
+// gets one.
+TEST(BackgroundMaskTest, NoMaskWhereTheTextureHasTheBackdropsGrey) {
+  Renderer renderer;
+  Eigen::MatrixXd V;
+  Eigen::MatrixXi F;
+  MakeBumpySphere(4, 0.08, &V, &F);
+  TestSceneOptions scene;
+  for (const double background : {0.0, 0.3}) {
+    scene.background = background;
+    const InMemoryViewSource source = MakeTestScene(V, F, scene, {}, &renderer);
+    BackgroundMaskReport report;
+    const auto masked = MakeBackgroundMasks(source, V, F, &renderer, {}, &report);
+    EXPECT_EQ(report.num_uniform, scene.num_views) << background;
+    const double clearest = *std::max_element(report.clear_share.begin(), report.clear_share.end());
+    const double least = *std::min_element(report.clear_share.begin(), report.clear_share.end());
+    if (background == 0) {
+      EXPECT_GT(least, 0.98);
+      EXPECT_EQ(report.num_clear, scene.num_views);
+      EXPECT_EQ(report.num_accepted, scene.num_views);
+    } else {
+      EXPECT_LT(clearest, 0.75);
+      EXPECT_EQ(report.num_clear, 0);
+      EXPECT_EQ(report.num_accepted, 0);
+      EXPECT_FALSE(masked->HasMasks());
+      // Without the clarity rule every view would get its mask: their outer
+      // outlines agree with the mesh's (the patches of the texture with the
+      // backdrop's grey are holes, which the agreement leaves out).
+      BackgroundMaskOptions unclear;
+      unclear.min_clear_outline = 0;
+      MakeBackgroundMasks(source, V, F, &renderer, unclear, &report);
+      EXPECT_EQ(report.num_accepted, scene.num_views);
+    }
   }
 }
 

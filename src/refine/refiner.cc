@@ -1392,6 +1392,9 @@ void RegisterRefineOptions(OptionManager* o, RefineOptions* r) {
   o->Add("BackgroundMask.min_agreement", &r->background_mask.min_agreement,
          "a view's background mask is used when its intersection over union with the input "
          "mesh's rendered coverage is at least this");
+  o->Add("BackgroundMask.min_clear_outline", &r->background_mask.min_clear_outline,
+         "... and when at least this share of its outline is clearly unlike the background "
+         "(the object beside it differs by 3 tolerances on average)");
   o->Add("BackgroundMask.max_offset", &r->background_mask.max_offset,
          "a background mask moves the input mesh's outline by at most this share of the "
          "image's longest side");
