@@ -85,6 +85,15 @@ void ForEachBorderPixel(const cv::Mat& image, int band, Visit visit) {
   }
 }
 
+// Whether pixel (r, c) of `mask` (CV_8U) has a 4-neighbour outside it (0);
+// beyond the image counts as inside.
+bool OnOutline(const cv::Mat& mask, int r, int c) {
+  auto outside = [&](int rr, int cc) {
+    return rr >= 0 && rr < mask.rows && cc >= 0 && cc < mask.cols && mask.at<uchar>(rr, cc) == 0;
+  };
+  return outside(r - 1, c) || outside(r + 1, c) || outside(r, c - 1) || outside(r, c + 1);
+}
+
 BackgroundModel EstimateFiltered(const cv::Mat& filtered, const BackgroundMaskOptions& options) {
   std::vector<double> channel[3];
   ForEachBorderPixel(filtered, options.border_px, [&](const cv::Vec3b& p) {
@@ -146,13 +155,7 @@ cv::Mat MaskOfFiltered(const cv::Mat& filtered, const BackgroundModel& model,
   // background that differs from it by less than half as much as the object
   // pixels beside it is mostly background (an anti-aliased edge pixel).
   const cv::Mat before = mask.clone();
-  auto at = [&](const cv::Mat& m, int r, int c) {
-    return r >= 0 && r < rows && c >= 0 && c < cols ? m.at<uchar>(r, c) : uchar{255};
-  };
-  auto on_outline = [&](int r, int c) {
-    return at(before, r - 1, c) == 0 || at(before, r + 1, c) == 0 || at(before, r, c - 1) == 0 ||
-           at(before, r, c + 1) == 0;
-  };
+  auto on_outline = [&](int r, int c) { return OnOutline(before, r, c); };
   for (int r = 0; r < rows; ++r) {
     for (int c = 0; c < cols; ++c) {
       if (!before.at<uchar>(r, c) || !on_outline(r, c)) continue;
@@ -201,9 +204,7 @@ double ClearShareOfFiltered(const cv::Mat& filtered, const cv::Mat& mask,
   for (int r = 0; r < rows; ++r) {
     for (int c = 0; c < cols; ++c) {
       if (!inside(r, c)) continue;
-      const bool on_outline = (r > 0 && !inside(r - 1, c)) || (r + 1 < rows && !inside(r + 1, c)) ||
-                              (c > 0 && !inside(r, c - 1)) || (c + 1 < cols && !inside(r, c + 1));
-      if (!on_outline) continue;
+      if (!OnOutline(mask, r, c)) continue;
       double sum = 0;  // over the object pixels of the 5x5 window
       int count = 0;
       for (int rr = std::max(0, r - 2); rr <= std::min(rows - 1, r + 2); ++rr) {
