@@ -1391,7 +1391,7 @@ void RegisterRefineOptions(OptionManager* o, RefineOptions* r) {
          "(pixels)");
   o->Add("BackgroundMask.min_agreement", &r->background_mask.min_agreement,
          "a view's background mask is used when its intersection over union with the input "
-         "mesh's rendered coverage is at least this");
+         "mesh's rendered coverage, both with their holes filled, is at least this");
   o->Add("BackgroundMask.min_clear_outline", &r->background_mask.min_clear_outline,
          "... and when at least this share of its outline is clearly unlike the background "
          "(the object beside it differs by 3 tolerances on average)");
