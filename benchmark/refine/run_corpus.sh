@@ -26,7 +26,7 @@ source benchmark/refine/corpus_lib.sh
 configs=""
 if [ "${DEFAULTS:-1}" != 0 ]; then configs+="defaults|"$'\n'; fi
 if [ "${BASELINE:-1}" != 0 ]; then
-  configs+="zncc+laplacian|--Refine.similarity zncc --Refine.regularizer laplacian"$'\n'
+  configs+="zncc+laplacian|--Refine.similarity zncc --Refine.regularizer laplacian --Refine.open_border_rings 0"$'\n'
 fi
 if [ -n "${CONFIGS:-}" ]; then configs+=$'\n'"$CONFIGS"; fi
 

@@ -50,7 +50,7 @@ for scene in $SCENES; do
   fi
   row "$scene" "COLMAP Poisson (input)" "$ws/dense/meshed-poisson.ply" "" ""
   for config in "dcv+lp:--Refine.similarity dcv --Refine.regularizer lp" \
-                "zncc+laplacian:--Refine.similarity zncc --Refine.regularizer laplacian"; do
+                "zncc+laplacian:--Refine.similarity zncc --Refine.regularizer laplacian --Refine.open_border_rings 0"; do
     label=${config%%:*}
     flags=${config#*:}
     out="$ws/dense/meshed-refined-${label/+/-}.ply"

@@ -140,6 +140,82 @@ std::vector<std::vector<int>> VertexAdjacency(const Eigen::MatrixXi& F, int num_
   return adj;
 }
 
+VertexBand OpenBorderBand(const Eigen::MatrixXi& F, int num_vertices, int rings) {
+  VertexBand band;
+  if (rings <= 0 || F.rows() == 0) return band;
+  // Undirected edges, each once per face; an edge listed once bounds one face.
+  std::vector<std::pair<int, int>> edges;
+  edges.reserve(static_cast<size_t>(F.rows()) * 3);
+  for (int f = 0; f < F.rows(); ++f) {
+    for (int k = 0; k < 3; ++k) {
+      const int a = F(f, k), b = F(f, (k + 1) % 3);
+      if (a != b) edges.emplace_back(std::min(a, b), std::max(a, b));
+    }
+  }
+  std::sort(edges.begin(), edges.end());
+  std::vector<int> ring(num_vertices, 0);  // 0: not in the band
+  for (size_t i = 0; i < edges.size();) {
+    size_t j = i;
+    while (j < edges.size() && edges[j] == edges[i]) ++j;
+    if (j - i == 1) {
+      for (const int v : {edges[i].first, edges[i].second}) {
+        if (ring[v] == 0) {
+          ring[v] = 1;
+          band.vertices.push_back(v);
+        }
+      }
+    }
+    i = j;
+  }
+  band.num_border = static_cast<int>(band.vertices.size());
+  if (band.vertices.empty()) return band;
+  // One-ring neighbours (compressed rows, from the unique edges).
+  edges.erase(std::unique(edges.begin(), edges.end()), edges.end());
+  std::vector<int> offsets(num_vertices + 1, 0), adjacent(edges.size() * 2);
+  for (const auto& [a, b] : edges) {
+    ++offsets[a + 1];
+    ++offsets[b + 1];
+  }
+  for (int v = 0; v < num_vertices; ++v) offsets[v + 1] += offsets[v];
+  std::vector<int> fill(offsets.begin(), offsets.end() - 1);
+  for (const auto& [a, b] : edges) {
+    adjacent[fill[a]++] = b;
+    adjacent[fill[b]++] = a;
+  }
+  for (size_t i = 0; i < band.vertices.size(); ++i) {
+    const int v = band.vertices[i];
+    if (ring[v] >= rings) continue;
+    for (int j = offsets[v]; j < offsets[v + 1]; ++j) {
+      const int w = adjacent[j];
+      if (ring[w] == 0) {
+        ring[w] = ring[v] + 1;
+        band.vertices.push_back(w);
+      }
+    }
+  }
+  band.neighbours.values.reserve(band.vertices.size() * 6);
+  for (const int v : band.vertices) {
+    band.neighbours.values.insert(band.neighbours.values.end(), adjacent.begin() + offsets[v],
+                                  adjacent.begin() + offsets[v + 1]);
+    band.neighbours.offsets.push_back(static_cast<int>(band.neighbours.values.size()));
+  }
+  return band;
+}
+
+void MembraneStep(const VertexBand& band, double step, Eigen::MatrixXd* V) {
+  const int n = static_cast<int>(band.vertices.size());
+  Eigen::MatrixXd moves = Eigen::MatrixXd::Zero(n, 3);
+  for (int i = 0; i < n; ++i) {
+    const IndexLists::List neighbours = band.neighbours[i];
+    if (neighbours.size() == 0) continue;
+    Eigen::RowVector3d mean = Eigen::RowVector3d::Zero();
+    for (const int w : neighbours) mean += V->row(w);
+    mean /= static_cast<double>(neighbours.size());
+    moves.row(i) = step * (mean - V->row(band.vertices[i]));
+  }
+  for (int i = 0; i < n; ++i) V->row(band.vertices[i]) += moves.row(i);
+}
+
 std::vector<int> RemoveUnreferencedVertices(Eigen::MatrixXd* V, Eigen::MatrixXi* F) {
   std::vector<int> map(V->rows(), -1);
   int next = 0;

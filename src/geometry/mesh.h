@@ -85,6 +85,24 @@ EdgeTopology ComputeEdgeTopology(const Eigen::MatrixXi& F, int num_vertices);
 // For each vertex, its one-ring neighbour vertices (sorted, unique).
 std::vector<std::vector<int>> VertexAdjacency(const Eigen::MatrixXi& F, int num_vertices);
 
+// The vertices within `rings` edge rings of an open border, each with its
+// one-ring neighbours. Ring 1 are the vertices of the edges that bound a
+// single face, ring k + 1 the neighbours of ring k not in an earlier ring;
+// edges with three or more faces are not border. A closed mesh, or rings <= 0,
+// gives an empty band.
+struct VertexBand {
+  std::vector<int> vertices;  // in ring order
+  IndexLists neighbours;      // neighbours[i] of vertices[i]
+  int num_border = 0;         // how many of `vertices` are on the border (ring 1)
+};
+VertexBand OpenBorderBand(const Eigen::MatrixXi& F, int num_vertices, int rings);
+
+// One step of the membrane (umbrella) flow on the band, all vertices at once:
+// each band vertex moves by `step` x (the mean of its neighbours - itself).
+// Vertices outside the band do not move. On an open border this shortens the
+// border and pulls the band toward the surface inside it.
+void MembraneStep(const VertexBand& band, double step, Eigen::MatrixXd* V);
+
 // Removes vertices referenced by no face; `F` is re-indexed in place. Returns
 // for each old vertex its new index or -1.
 std::vector<int> RemoveUnreferencedVertices(Eigen::MatrixXd* V, Eigen::MatrixXi* F);

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <array>
+#include <cmath>
 #include <cstdio>
 #include <map>
 #include <numeric>
@@ -11,6 +12,7 @@
 #include <Eigen/LU>
 
 #include "geometry/mesh.h"
+#include "geometry/primitives.h"
 #include "geometry/view.h"
 
 namespace mr {
@@ -236,6 +238,102 @@ TEST(Mesh, OrderSpatiallyKeepsTheSurfaceAndGathersNeighbours) {
   Eigen::MatrixXd E(0, 3);
   Eigen::MatrixXi EF(0, 3);
   EXPECT_TRUE(OrderSpatially(&E, &EF).empty());
+}
+
+// A flat n x n grid in z = 0 over [0, 1]^2: its border is the square's outline.
+void FlatGrid(int cells, Eigen::MatrixXd* V, Eigen::MatrixXi* F) {
+  *V = Eigen::MatrixXd(0, 3);
+  *F = Eigen::MatrixXi(0, 3);
+  AppendGrid(Eigen::Vector3d::Zero(), Eigen::Vector3d::UnitX(), Eigen::Vector3d::UnitY(), cells, V,
+             F);
+}
+
+// Edge rings from the grid's outline: 1 on it, k + 1 on the k-th square inside.
+int GridRing(const Eigen::RowVector3d& p, int cells) {
+  const double d = std::min({p.x(), p.y(), 1 - p.x(), 1 - p.y()});
+  return static_cast<int>(std::lround(d * cells)) + 1;
+}
+
+TEST(OpenBorderBand, HoldsTheRingsOfTheBorderOfAnOpenMeshAndNothingOfAClosedOne) {
+  Eigen::MatrixXd V;
+  Eigen::MatrixXi F;
+  MakeIcosphere(2, 1.0, &V, &F);
+  EXPECT_TRUE(OpenBorderBand(F, static_cast<int>(V.rows()), 3).vertices.empty());
+
+  constexpr int kCells = 10;
+  FlatGrid(kCells, &V, &F);
+  EXPECT_TRUE(OpenBorderBand(F, static_cast<int>(V.rows()), 0).vertices.empty());
+  for (int rings = 1; rings <= 3; ++rings) {
+    const VertexBand band = OpenBorderBand(F, static_cast<int>(V.rows()), rings);
+    EXPECT_EQ(band.num_border, 4 * kCells);
+    // The vertices within `rings` rings, and only those, each with its
+    // one-ring neighbours (the triangulated grid's 3 to 6).
+    int expected = 0;
+    for (int v = 0; v < V.rows(); ++v) expected += GridRing(V.row(v), kCells) <= rings ? 1 : 0;
+    ASSERT_EQ(static_cast<int>(band.vertices.size()), expected);
+    ASSERT_EQ(band.neighbours.size(), band.vertices.size());
+    for (size_t i = 0; i < band.vertices.size(); ++i) {
+      const int v = band.vertices[i];
+      EXPECT_LE(GridRing(V.row(v), kCells), rings);
+      EXPECT_EQ(GridRing(V.row(v), kCells) == 1, static_cast<int>(i) < band.num_border);
+      EXPECT_GE(band.neighbours[i].size(), 2u);
+      EXPECT_LE(band.neighbours[i].size(), 6u);
+      for (const int w : band.neighbours[i]) {
+        EXPECT_NEAR((V.row(w) - V.row(v)).norm(), 1.0 / kCells, 1.0 / kCells * 0.5)
+            << "not a one-ring neighbour";
+      }
+    }
+  }
+}
+
+TEST(MembraneStep, PullsAFlaredSkirtInAndLeavesTheInsideAlone) {
+  // A flat grid whose outermost ring is bent down and out, as the skirt
+  // COLMAP's trimmed Poisson surface often ends in.
+  constexpr int kCells = 12;
+  Eigen::MatrixXd V;
+  Eigen::MatrixXi F;
+  FlatGrid(kCells, &V, &F);
+  for (int v = 0; v < V.rows(); ++v) {
+    if (GridRing(V.row(v), kCells) == 1) {
+      const Eigen::RowVector3d outward(V(v, 0) - 0.5, V(v, 1) - 0.5, 0);
+      V.row(v) += 0.3 * outward + Eigen::RowVector3d(0, 0, -0.2);
+    }
+  }
+  const Eigen::MatrixXd V0 = V;
+  const VertexBand band = OpenBorderBand(F, static_cast<int>(V.rows()), 3);
+  auto border_sag = [&](const Eigen::MatrixXd& X) {
+    double sag = 0;
+    for (int i = 0; i < band.num_border; ++i) sag = std::max(sag, -X(band.vertices[i], 2));
+    return sag;
+  };
+  auto border_reach = [&](const Eigen::MatrixXd& X) {
+    double reach = 0;
+    for (int i = 0; i < band.num_border; ++i) {
+      const int v = band.vertices[i];
+      reach = std::max(reach, std::max(std::abs(X(v, 0) - 0.5), std::abs(X(v, 1) - 0.5)));
+    }
+    return reach;
+  };
+  for (int step = 0; step < 10; ++step) MembraneStep(band, 0.5, &V);
+  // The skirt comes up and in: its sag down by more than a third (it spreads
+  // into the band, which the fixed inside then lifts), its reach back to
+  // within the square.
+  EXPECT_LT(border_sag(V), 0.65 * border_sag(V0));
+  EXPECT_LT(border_reach(V), 0.5);
+  EXPECT_GT(border_reach(V0), 0.6);
+  // Beyond the band nothing moves.
+  std::vector<char> in_band(V.rows(), 0);
+  for (const int v : band.vertices) in_band[v] = 1;
+  for (int v = 0; v < V.rows(); ++v) {
+    if (!in_band[v]) {
+      EXPECT_EQ(V.row(v), V0.row(v)) << v;
+    }
+  }
+
+  // A flat band stays in its plane.
+  FlatGrid(kCells, &V, &F);
+  MembraneStep(band, 0.5, &V);
+  EXPECT_LT(V.col(2).cwiseAbs().maxCoeff(), 1e-15);
 }
 
 }  // namespace

@@ -136,6 +136,12 @@ void RefineCamerasAtLevel(const RefineOptions& options,
 // pieces; docs/results.md, "Speed and memory").
 constexpr int kDecimateFacesPerPiece = 50000;
 
+// The open border's membrane step (RefineOptions::open_border_rings): half-way
+// to the neighbours' mean. The umbrella operator's eigenvalues lie in
+// [-2, 0], so this is the largest explicit step that flips the sign of no
+// frequency (no zig-zag is made worse).
+constexpr double kOpenBorderStep = 0.5;
+
 // Remeshes to the level's target edge length, within the face budget.
 // Returns false, leaving (V, F) half-done, when *cancel (if given) was set
 // before the end; it is checked during the decimation and between stages.
@@ -630,6 +636,9 @@ bool RefineOptions::Check() const {
   if (!std::isfinite(hull_margin_px)) {
     fail("hull_margin_px", std::to_string(hull_margin_px), "a finite number (< 0: off)");
   }
+  if (open_border_rings < 0) {
+    fail("open_border_rings", std::to_string(open_border_rings), "open_border_rings >= 0 (0: off)");
+  }
   if (light != "world" && light != "headlight" && light != "auto") {
     fail("light", light, "one of world, headlight, auto");
   }
@@ -930,6 +939,12 @@ RefineSummary RefineMesh(const ViewSource& input_source, const RefineOptions& op
     RenderCache renders(renderer, views, cache_bytes / 2);
     MR_LOG(INFO) << "Level " << level << ": " << views[0].width << "x" << views[0].height
                  << " images, " << F.rows() << " faces";
+    const VertexBand border_band = OpenBorderBand(F, static_cast<int>(V.rows()), options.open_border_rings);
+    if (border_band.num_border > 0) {
+      MR_LOG(INFO) << "Open border: " << border_band.num_border << " vertices; "
+                   << border_band.vertices.size() << " within " << options.open_border_rings
+                   << " rings take a membrane step each iteration (Refine.open_border_rings)";
+    }
     const bool use_silhouettes = options.silhouette_weight > 0 && source.HasMasks();
     // The finest level's iterates from average_from on are summed. After a
     // camera round the surface settles again before any iterate is averaged
@@ -1126,6 +1141,7 @@ RefineSummary RefineMesh(const ViewSource& input_source, const RefineOptions& op
       } else {
         V = V_half;
       }
+      MembraneStep(border_band, kOpenBorderStep, &V);
       const double t_cleanup = ElapsedSeconds();
       record.denoise_seconds = t_cleanup - t_denoise;
       summary.flipped_faces_fixed += FixFlippedFaces(V_before, F, &V).initial_flipped;
@@ -1377,6 +1393,9 @@ void RegisterRefineOptions(OptionManager* o, RefineOptions* r) {
   o->Add("Refine.hull_margin_px", &r->hull_margin_px,
          "with the silhouette term: pull back every vertex that projects more than this many "
          "pixels outside a mask (the visual hull); < 0: only contour vertices");
+  o->Add("Refine.open_border_rings", &r->open_border_rings,
+         "vertices within this many edge rings of an open border take a membrane step each "
+         "iteration, which pulls in unsupported skirts (1: the border only; 0: off)");
   o->Add("Refine.masks_from_background", &r->masks_from_background,
          "without masks, make them from a uniform background where they agree with the input "
          "mesh (for the silhouette term)");

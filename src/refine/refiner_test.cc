@@ -1171,6 +1171,14 @@ TEST(RefineOptions, BadValuesNameTheField) {
   } catch (const InputError& e) {
     EXPECT_NE(std::string(e.what()).find("similarity"), std::string::npos);
   }
+  options = RefineOptions();
+  options.open_border_rings = -1;
+  try {
+    options.Check();
+    FAIL() << "expected InputError";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("open_border_rings"), std::string::npos);
+  }
 }
 
 }  // namespace
