@@ -187,6 +187,15 @@ ImageHeader ReadPnmHeader(const std::string& path, const std::string& data) {
     while (pos < data.size() && std::isdigit(static_cast<unsigned char>(data[pos]))) {
       v = std::min<int64_t>(v * 10 + (data[pos++] - '0'), int64_t(1) << 32);  // no overflow
     }
+    // Netpbm separates the numbers by white space. OpenCV's reader takes the
+    // byte after a number as its separator whatever it is, so a comment that
+    // touches a number ("1555#5\r9") hides its '#' from OpenCV, which then
+    // reads the comment's digits as the next number: a header that says
+    // 1555 x 9 here made OpenCV allocate 1555 x 555555 pixels (fuzzing).
+    if (pos < data.size() && !std::isspace(static_cast<unsigned char>(data[pos]))) {
+      MR_THROW_INPUT << path << ": PNM header: white space expected after the number ending at byte "
+                     << pos << " (corrupt header)";
+    }
     return v;
   };
   ImageHeader header{"PNM", 0, 0, kind == '3' || kind == '6' ? 3 : 1, 1};

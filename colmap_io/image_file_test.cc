@@ -107,6 +107,21 @@ TEST(ImageFile, HugeHeadersAreRefusedBeforeDecoding) {
   EXPECT_NE(ErrorOf([&] { DecodeImageFile("e.pgm", "P5 0 7 255\n", cv::IMREAD_COLOR); })
                 .find("e.pgm: PNM header gives a size of 0 x 7 pixels (corrupt)"),
             std::string::npos);
+
+  // A comment that touches a number (a fuzz finding): OpenCV takes the '#' as
+  // the number's separator and reads the comment's digits as the height,
+  // 1555 x 555555 pixels where this header reads 1555 x 5.
+  EXPECT_NE(ErrorOf([&] {
+              DecodeImageFile("h.pbm", "P1\r\r1555#555555\r\r5", cv::IMREAD_COLOR);
+            }).find("h.pbm: PNM header: white space expected after the number ending at byte 8"),
+            std::string::npos);
+  // A comment on a line of its own is read as before.
+  const cv::Mat commented =
+      DecodeImageFile("k.pgm", "P2\n# made by hand\n2 1 # width, height\n255\n0 255\n",
+                      cv::IMREAD_GRAYSCALE);
+  ASSERT_EQ(commented.cols, 2);
+  ASSERT_EQ(commented.rows, 1);
+  EXPECT_EQ(commented.at<uint8_t>(0, 1), 255);
 }
 
 // Within the pixel limit, the decoded bytes are limited too: 16384 x 16384
