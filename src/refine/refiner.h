@@ -212,14 +212,16 @@ struct RefineOptions {
   // An open border (COLMAP's trimmed Poisson mesh, a cut-off visual hull)
   // ends where the surface was extrapolated: a skirt that no view sees
   // squarely, often flared away from the object, that the data term cannot
-  // correct. Each iteration, the vertices within this many edge rings of an
-  // open border (1: the border's own) take one step of a membrane flow
-  // (half-way to the mean of their neighbours), which shortens the border
-  // and pulls unsupported skirts in; where the images support the surface,
-  // the data term holds it. 0: off. Chosen on the development corpus by the
-  // worst case (docs/results.md, "Open borders"): 3 rings took
-  // cheburashka-grey-nomask from 0.502x to 0.369x the input's accuracy90.
-  int open_border_rings = 3;
+  // correct. With open_border_rings > 0, at the finest level, the vertices
+  // within this many edge rings of an open border (1: the border's own) take
+  // one step of a membrane flow each iteration (half-way to the mean of their
+  // neighbours), which shortens the border and pulls unsupported skirts in.
+  // Off by default: on the development corpus 3 rings took
+  // cheburashka-grey-nomask from 0.502x to 0.369x the input's accuracy90, but
+  // the retraction is not bounded, and on a small object refined over three
+  // levels (homer-color-small, --Refine.num_levels 3) it cost 5.4 points of
+  // completeness (docs/results.md, "Open borders: a membrane").
+  int open_border_rings = 0;
   BackgroundMaskOptions background_mask;
   // With given masks: measure where the images' edges lie across the masks'
   // outlines and, when they lie clearly off (masks grown for a visual hull,
