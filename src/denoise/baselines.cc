@@ -11,59 +11,16 @@
 namespace mr {
 namespace {
 
-// Compressed adjacency lists: neighbours of i are adj[offset[i] .. offset[i+1]).
-struct Csr {
-  std::vector<int> offset, adj;
-};
-
-Csr VertexNeighbours(const Eigen::MatrixXi& F, int n) {
-  std::vector<std::pair<int, int>> pairs;
-  pairs.reserve(static_cast<size_t>(F.rows()) * 6);
-  for (int f = 0; f < F.rows(); ++f) {
-    for (int k = 0; k < 3; ++k) {
-      const int a = F(f, k), b = F(f, (k + 1) % 3);
-      if (a == b) continue;
-      pairs.emplace_back(a, b);
-      pairs.emplace_back(b, a);
-    }
-  }
-  std::sort(pairs.begin(), pairs.end());
-  pairs.erase(std::unique(pairs.begin(), pairs.end()), pairs.end());
-  Csr csr;
-  csr.offset.assign(n + 1, 0);
-  for (const auto& p : pairs) ++csr.offset[p.first + 1];
-  for (int i = 0; i < n; ++i) csr.offset[i + 1] += csr.offset[i];
-  csr.adj.resize(pairs.size());
-  for (size_t i = 0; i < pairs.size(); ++i) csr.adj[i] = pairs[i].second;
-  return csr;
-}
-
-// Faces incident to each vertex.
-Csr VertexFaces(const Eigen::MatrixXi& F, int n) {
-  Csr csr;
-  csr.offset.assign(n + 1, 0);
-  for (int f = 0; f < F.rows(); ++f) {
-    for (int k = 0; k < 3; ++k) ++csr.offset[F(f, k) + 1];
-  }
-  for (int i = 0; i < n; ++i) csr.offset[i + 1] += csr.offset[i];
-  csr.adj.resize(csr.offset[n]);
-  std::vector<int> fill(csr.offset.begin(), csr.offset.end() - 1);
-  for (int f = 0; f < F.rows(); ++f) {
-    for (int k = 0; k < 3; ++k) csr.adj[fill[F(f, k)]++] = f;
-  }
-  return csr;
-}
-
-Eigen::MatrixXd Umbrella(const Csr& nb, const Eigen::MatrixXd& X) {
+Eigen::MatrixXd Umbrella(const IndexLists& nb, const Eigen::MatrixXd& X) {
   const int n = static_cast<int>(X.rows());
   Eigen::MatrixXd L = Eigen::MatrixXd::Zero(n, 3);
 #pragma omp parallel for schedule(static) if (n > 50000)
   for (int i = 0; i < n; ++i) {
-    const int b = nb.offset[i], e = nb.offset[i + 1];
-    if (e == b) continue;
+    const IndexLists::List neighbours = nb[i];
+    if (neighbours.size() == 0) continue;
     Eigen::RowVector3d s = Eigen::RowVector3d::Zero();
-    for (int j = b; j < e; ++j) s += X.row(nb.adj[j]);
-    L.row(i) = s / (e - b) - X.row(i);
+    for (const int j : neighbours) s += X.row(j);
+    L.row(i) = s / static_cast<double>(neighbours.size()) - X.row(i);
   }
   return L;
 }
@@ -72,7 +29,7 @@ Eigen::MatrixXd Umbrella(const Csr& nb, const Eigen::MatrixXd& X) {
 
 Eigen::MatrixXd LaplacianSmooth(const Eigen::MatrixXd& V, const Eigen::MatrixXi& F,
                                 int iterations, double w1, double w2) {
-  const Csr nb = VertexNeighbours(F, static_cast<int>(V.rows()));
+  const IndexLists nb = VertexAdjacency(F, static_cast<int>(V.rows()));
   Eigen::MatrixXd X = V;
   for (int it = 0; it < iterations; ++it) {
     const Eigen::MatrixXd L = Umbrella(nb, X);
@@ -91,7 +48,7 @@ namespace {
 // spatial sigma from X, then the normal filtering and the vertex fitting.
 // `vf` are the faces of each vertex, `ring` the faces sharing a vertex with
 // each face.
-void BilateralNormalRound(const Eigen::MatrixXi& F, const Csr& vf,
+void BilateralNormalRound(const Eigen::MatrixXi& F, const IndexLists& vf,
                           const std::vector<std::vector<int>>& ring, int normal_iterations,
                           int vertex_iterations, double normal_sigma, double spatial_sigma,
                           Eigen::MatrixXd* X_in_out) {
@@ -145,14 +102,11 @@ void BilateralNormalRound(const Eigen::MatrixXi& F, const Csr& vf,
     Eigen::MatrixXd Xn = X;
 #pragma omp parallel for schedule(static) if (n > 50000)
     for (int v = 0; v < n; ++v) {
-      const int b = vf.offset[v], e = vf.offset[v + 1];
-      if (e == b) continue;
+      const IndexLists::List faces = vf[v];
+      if (faces.size() == 0) continue;
       Eigen::RowVector3d d = Eigen::RowVector3d::Zero();
-      for (int j = b; j < e; ++j) {
-        const int f = vf.adj[j];
-        d += N.row(f) * N.row(f).dot(C.row(f) - X.row(v));
-      }
-      Xn.row(v) += d / (e - b);
+      for (const int f : faces) d += N.row(f) * N.row(f).dot(C.row(f) - X.row(v));
+      Xn.row(v) += d / static_cast<double>(faces.size());
     }
     X = Xn;
 #pragma omp parallel for schedule(static) if (n > 50000)
@@ -170,7 +124,7 @@ Eigen::MatrixXd BilateralNormalFilter(const Eigen::MatrixXd& V, const Eigen::Mat
                                       int outer_iterations) {
   const int n = static_cast<int>(V.rows()), nf = static_cast<int>(F.rows());
   if (nf == 0) return V;
-  const Csr vf = VertexFaces(F, n);
+  const IndexLists vf = VertexFaces(F, n);
   // Face neighbourhoods: faces sharing a vertex (Zheng et al.'s local scheme).
   std::vector<std::vector<int>> ring(nf);
 #pragma omp parallel for schedule(dynamic, 256) if (nf > 50000)
@@ -178,8 +132,8 @@ Eigen::MatrixXd BilateralNormalFilter(const Eigen::MatrixXd& V, const Eigen::Mat
     std::vector<int>& r = ring[f];
     for (int k = 0; k < 3; ++k) {
       const int v = F(f, k);
-      for (int j = vf.offset[v]; j < vf.offset[v + 1]; ++j) {
-        if (vf.adj[j] != f) r.push_back(vf.adj[j]);
+      for (const int g : vf[v]) {
+        if (g != f) r.push_back(g);
       }
     }
     std::sort(r.begin(), r.end());

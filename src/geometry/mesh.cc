@@ -125,68 +125,67 @@ EdgeTopology ComputeEdgeTopology(const Eigen::MatrixXi& F, int num_vertices) {
   return topo;
 }
 
-std::vector<std::vector<int>> VertexAdjacency(const Eigen::MatrixXi& F, int num_vertices) {
-  std::vector<std::vector<int>> adj(num_vertices);
+IndexLists VertexAdjacency(const Eigen::MatrixXi& F, int num_vertices) {
+  // Directed edges both ways, sorted: runs of equal first vertices are the rows.
+  std::vector<std::pair<int, int>> pairs;
+  pairs.reserve(static_cast<size_t>(F.rows()) * 6);
   for (int f = 0; f < F.rows(); ++f) {
     for (int k = 0; k < 3; ++k) {
-      adj[F(f, k)].push_back(F(f, (k + 1) % 3));
-      adj[F(f, k)].push_back(F(f, (k + 2) % 3));
+      const int a = F(f, k), b = F(f, (k + 1) % 3);
+      if (a == b) continue;
+      pairs.emplace_back(a, b);
+      pairs.emplace_back(b, a);
     }
   }
-  for (auto& a : adj) {
-    std::sort(a.begin(), a.end());
-    a.erase(std::unique(a.begin(), a.end()), a.end());
+  std::sort(pairs.begin(), pairs.end());
+  pairs.erase(std::unique(pairs.begin(), pairs.end()), pairs.end());
+  IndexLists adjacency;
+  adjacency.offsets.assign(static_cast<size_t>(num_vertices) + 1, 0);
+  for (const auto& p : pairs) ++adjacency.offsets[p.first + 1];
+  for (int v = 0; v < num_vertices; ++v) adjacency.offsets[v + 1] += adjacency.offsets[v];
+  adjacency.values.resize(pairs.size());
+  for (size_t i = 0; i < pairs.size(); ++i) adjacency.values[i] = pairs[i].second;
+  return adjacency;
+}
+
+IndexLists VertexFaces(const Eigen::MatrixXi& F, int num_vertices) {
+  IndexLists vf;
+  vf.offsets.assign(static_cast<size_t>(num_vertices) + 1, 0);
+  for (int f = 0; f < F.rows(); ++f) {
+    for (int k = 0; k < 3; ++k) ++vf.offsets[F(f, k) + 1];
   }
-  return adj;
+  for (int v = 0; v < num_vertices; ++v) vf.offsets[v + 1] += vf.offsets[v];
+  vf.values.resize(vf.offsets[num_vertices]);
+  std::vector<int> fill(vf.offsets.begin(), vf.offsets.end() - 1);
+  for (int f = 0; f < F.rows(); ++f) {
+    for (int k = 0; k < 3; ++k) vf.values[fill[F(f, k)]++] = f;
+  }
+  return vf;
 }
 
 VertexBand OpenBorderBand(const Eigen::MatrixXi& F, int num_vertices, int rings) {
   VertexBand band;
   if (rings <= 0 || F.rows() == 0) return band;
-  // Undirected edges, each once per face; an edge listed once bounds one face.
-  std::vector<std::pair<int, int>> edges;
-  edges.reserve(static_cast<size_t>(F.rows()) * 3);
-  for (int f = 0; f < F.rows(); ++f) {
-    for (int k = 0; k < 3; ++k) {
-      const int a = F(f, k), b = F(f, (k + 1) % 3);
-      if (a != b) edges.emplace_back(std::min(a, b), std::max(a, b));
-    }
-  }
-  std::sort(edges.begin(), edges.end());
   std::vector<int> ring(num_vertices, 0);  // 0: not in the band
-  for (size_t i = 0; i < edges.size();) {
-    size_t j = i;
-    while (j < edges.size() && edges[j] == edges[i]) ++j;
-    if (j - i == 1) {
-      for (const int v : {edges[i].first, edges[i].second}) {
+  {
+    const EdgeTopology topology = ComputeEdgeTopology(F, num_vertices);
+    for (int e = 0; e < topology.E.rows(); ++e) {
+      if (topology.edge_faces[e].size() != 1) continue;
+      for (const int v : {topology.E(e, 0), topology.E(e, 1)}) {
         if (ring[v] == 0) {
           ring[v] = 1;
           band.vertices.push_back(v);
         }
       }
     }
-    i = j;
   }
   band.num_border = static_cast<int>(band.vertices.size());
   if (band.vertices.empty()) return band;
-  // One-ring neighbours (compressed rows, from the unique edges).
-  edges.erase(std::unique(edges.begin(), edges.end()), edges.end());
-  std::vector<int> offsets(num_vertices + 1, 0), adjacent(edges.size() * 2);
-  for (const auto& [a, b] : edges) {
-    ++offsets[a + 1];
-    ++offsets[b + 1];
-  }
-  for (int v = 0; v < num_vertices; ++v) offsets[v + 1] += offsets[v];
-  std::vector<int> fill(offsets.begin(), offsets.end() - 1);
-  for (const auto& [a, b] : edges) {
-    adjacent[fill[a]++] = b;
-    adjacent[fill[b]++] = a;
-  }
+  const IndexLists adjacency = VertexAdjacency(F, num_vertices);
   for (size_t i = 0; i < band.vertices.size(); ++i) {
     const int v = band.vertices[i];
     if (ring[v] >= rings) continue;
-    for (int j = offsets[v]; j < offsets[v + 1]; ++j) {
-      const int w = adjacent[j];
+    for (const int w : adjacency[v]) {
       if (ring[w] == 0) {
         ring[w] = ring[v] + 1;
         band.vertices.push_back(w);
@@ -195,14 +194,16 @@ VertexBand OpenBorderBand(const Eigen::MatrixXi& F, int num_vertices, int rings)
   }
   band.neighbours.values.reserve(band.vertices.size() * 6);
   for (const int v : band.vertices) {
-    band.neighbours.values.insert(band.neighbours.values.end(), adjacent.begin() + offsets[v],
-                                  adjacent.begin() + offsets[v + 1]);
+    const IndexLists::List neighbours = adjacency[v];
+    band.neighbours.values.insert(band.neighbours.values.end(), neighbours.begin(),
+                                  neighbours.end());
     band.neighbours.offsets.push_back(static_cast<int>(band.neighbours.values.size()));
   }
   return band;
 }
 
-void MembraneStep(const VertexBand& band, double step, Eigen::MatrixXd* V) {
+void MembraneStep(const VertexBand& band, double step, Eigen::MatrixXd* V,
+                  const Eigen::VectorXd* weights) {
   const int n = static_cast<int>(band.vertices.size());
   Eigen::MatrixXd moves = Eigen::MatrixXd::Zero(n, 3);
   for (int i = 0; i < n; ++i) {
@@ -211,7 +212,8 @@ void MembraneStep(const VertexBand& band, double step, Eigen::MatrixXd* V) {
     Eigen::RowVector3d mean = Eigen::RowVector3d::Zero();
     for (const int w : neighbours) mean += V->row(w);
     mean /= static_cast<double>(neighbours.size());
-    moves.row(i) = step * (mean - V->row(band.vertices[i]));
+    const double w = weights != nullptr ? (*weights)(i) : 1.0;
+    moves.row(i) = w * step * (mean - V->row(band.vertices[i]));
   }
   for (int i = 0; i < n; ++i) V->row(band.vertices[i]) += moves.row(i);
 }

@@ -82,8 +82,13 @@ struct EdgeTopology {
 };
 EdgeTopology ComputeEdgeTopology(const Eigen::MatrixXi& F, int num_vertices);
 
-// For each vertex, its one-ring neighbour vertices (sorted, unique).
-std::vector<std::vector<int>> VertexAdjacency(const Eigen::MatrixXi& F, int num_vertices);
+// For each vertex, its one-ring neighbour vertices (sorted, unique, never the
+// vertex itself).
+IndexLists VertexAdjacency(const Eigen::MatrixXi& F, int num_vertices);
+
+// For each vertex, the faces that use it, in increasing order (a face that
+// uses a vertex twice is listed twice).
+IndexLists VertexFaces(const Eigen::MatrixXi& F, int num_vertices);
 
 // The vertices within `rings` edge rings of an open border, each with its
 // one-ring neighbours. Ring 1 are the vertices of the edges that bound a
@@ -100,8 +105,10 @@ VertexBand OpenBorderBand(const Eigen::MatrixXi& F, int num_vertices, int rings)
 // One step of the membrane (umbrella) flow on the band, all vertices at once:
 // each band vertex moves by `step` x (the mean of its neighbours - itself).
 // Vertices outside the band do not move. On an open border this shortens the
-// border and pulls the band toward the surface inside it.
-void MembraneStep(const VertexBand& band, double step, Eigen::MatrixXd* V);
+// border and pulls the band toward the surface inside it. With `weights`
+// (one per band vertex), band vertex i moves weights(i) times as far.
+void MembraneStep(const VertexBand& band, double step, Eigen::MatrixXd* V,
+                  const Eigen::VectorXd* weights = nullptr);
 
 // Removes vertices referenced by no face; `F` is re-indexed in place. Returns
 // for each old vertex its new index or -1.

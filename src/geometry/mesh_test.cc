@@ -334,6 +334,23 @@ TEST(MembraneStep, PullsAFlaredSkirtInAndLeavesTheInsideAlone) {
   FlatGrid(kCells, &V, &F);
   MembraneStep(band, 0.5, &V);
   EXPECT_LT(V.col(2).cwiseAbs().maxCoeff(), 1e-15);
+
+  // With weights, a band vertex of weight 0 stays, one of weight w moves w
+  // times as far as without them.
+  V = V0;
+  Eigen::MatrixXd V_full = V0;
+  MembraneStep(band, 0.5, &V_full);
+  Eigen::VectorXd weights = Eigen::VectorXd::Ones(band.vertices.size());
+  weights(0) = 0;
+  weights(1) = 0.25;
+  MembraneStep(band, 0.5, &V, &weights);
+  const int held = band.vertices[0], quarter = band.vertices[1], free = band.vertices[2];
+  EXPECT_EQ(V.row(held), V0.row(held));
+  EXPECT_GT((V_full.row(quarter) - V0.row(quarter)).norm(), 1e-3);
+  EXPECT_LT((V.row(quarter) - V0.row(quarter) - 0.25 * (V_full.row(quarter) - V0.row(quarter)))
+                .norm(),
+            1e-15);
+  EXPECT_EQ(V.row(free), V_full.row(free));
 }
 
 }  // namespace

@@ -820,7 +820,7 @@ RemoveSelfIntersectionsSummary RemoveSelfIntersections(
   // Fallback: umbrella smoothing of the intersecting faces' vertices and
   // their one-ring, re-checked after every round.
   for (int round = 0; round < options.smoothing_rounds && report.intersecting_pairs > 0; ++round) {
-    const std::vector<std::vector<int>> adjacency = VertexAdjacency(*F, V->rows());
+    const IndexLists adjacency = VertexAdjacency(*F, V->rows());
     std::vector<int> verts;
     for (const auto& p : report.pairs) {
       for (int f : {p.first, p.second}) {

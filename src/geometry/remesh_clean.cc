@@ -94,21 +94,14 @@ int ProcessVertexFans(const EdgeTopology& topo, Eigen::MatrixXd* V, Eigen::Matri
                       int* num_copies) {
   *num_copies = 0;
   const int nv = V->rows();
-  std::vector<int> start(nv + 1, 0);
-  for (int f = 0; f < F->rows(); ++f)
-    for (int k = 0; k < 3; ++k) ++start[(*F)(f, k) + 1];
-  for (int v = 0; v < nv; ++v) start[v + 1] += start[v];
-  std::vector<int> vf(start[nv]);
-  std::vector<int> fill(start.begin(), start.end() - 1);
-  for (int f = 0; f < F->rows(); ++f)
-    for (int k = 0; k < 3; ++k) vf[fill[(*F)(f, k)]++] = f;
+  const IndexLists vertex_faces = VertexFaces(*F, nv);
 
   int bad = 0;
   std::vector<Eigen::RowVector3d> new_positions;
   for (int v = 0; v < nv; ++v) {
-    const int n = start[v + 1] - start[v];
+    const int n = static_cast<int>(vertex_faces[v].size());
     if (n <= 1) continue;
-    const int* faces = vf.data() + start[v];
+    const int* faces = vertex_faces[v].begin();
     UnionFind uf(n);
     for (int i = 0; i < n; ++i) {
       const int f = faces[i];
@@ -581,7 +574,7 @@ FixFlippedFacesSummary FixFlippedFaces(const Eigen::MatrixXd& V_before, const Ei
   std::vector<int> flipped = FlippedFaces(V_before, *V_after, F, options.max_angle_deg);
   summary.initial_flipped = static_cast<int>(flipped.size());
   if (!flipped.empty()) {
-    const std::vector<std::vector<int>> adjacency = VertexAdjacency(F, V_after->rows());
+    const IndexLists adjacency = VertexAdjacency(F, V_after->rows());
     // Phase 1: umbrella smoothing of the vertices of flipped faces.
     for (int round = 0; round < options.smoothing_rounds && !flipped.empty(); ++round) {
       std::vector<int> verts;
