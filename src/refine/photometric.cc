@@ -153,6 +153,7 @@ void DataTerm::Reset(int num_vertices) {
   curvature = Eigen::VectorXd::Zero(num_vertices);
   weight = Eigen::VectorXd::Zero(num_vertices);
   footprint = Eigen::VectorXd::Zero(num_vertices);
+  similarity = Eigen::VectorXd::Zero(num_vertices);
   cost = 0;
   zncc_sum = 0;
   weight_sum = 0;
@@ -164,6 +165,7 @@ void DataTerm::Add(const DataTerm& other) {
   curvature += other.curvature;
   weight += other.weight;
   footprint += other.footprint;
+  similarity += other.similarity;
   cost += other.cost;
   zncc_sum += other.zncc_sum;
   weight_sum += other.weight_sum;
@@ -358,6 +360,7 @@ long DataTermAccumulator::AddPair(const MeshGeometry& mesh, const PinholeView& v
       const double v2 = dp ? maps.variance_predicted.at<double>(row, col)
                            : maps.variance_predicted.at<float>(row, col);
       const double pixel_footprint = footprint.at<double>(row, col);
+      const double m = dp ? maps.zncc.at<double>(row, col) : maps.zncc.at<float>(row, col);
       const double u = render_i.bary[2 * idx], v = render_i.bary[2 * idx + 1];
       const double w[3] = {1.0 - u - v, u, v};
       for (int k = 0; k < 3; ++k) {
@@ -366,6 +369,7 @@ long DataTermAccumulator::AddPair(const MeshGeometry& mesh, const PinholeView& v
         acc.curvature(vk) += w[k] * a * a / v2;
         acc.weight(vk) += w[k];
         acc.footprint(vk) += w[k] * pixel_footprint;
+        acc.similarity(vk) += w[k] * m;
       }
     }
   }

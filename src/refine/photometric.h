@@ -89,6 +89,7 @@ struct DataTerm {
   Eigen::VectorXd curvature;  // #V: Gauss-Newton curvature along the normal
   Eigen::VectorXd weight;     // #V: Σ_p w_k (pixel coverage)
   Eigen::VectorXd footprint;  // #V: Σ_p w_k * (pixel footprint in world units)
+  Eigen::VectorXd similarity; // #V: Σ_p w_k * m(p)
   double cost = 0;            // C = Σ_p W(p) (1 - m(p)) over all pairs
   double zncc_sum = 0;        // Σ_p W(p) m(p)
   double weight_sum = 0;      // Σ_p W(p)

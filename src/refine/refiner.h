@@ -210,17 +210,20 @@ struct RefineOptions {
   // input (accuracy90 / normal error) to 0.801x / 0.981x.
   bool masks_from_background = true;
   // An open border (COLMAP's trimmed Poisson mesh, a cut-off visual hull)
-  // ends where the surface was extrapolated: a skirt that no view sees
-  // squarely, often flared away from the object, that the data term cannot
+  // ends where the surface was extrapolated: often a skirt flared away from
+  // the object, inside every silhouette, that the data term does not
   // correct. With open_border_rings > 0, at the finest level, the vertices
   // within this many edge rings of an open border (1: the border's own) take
   // one step of a membrane flow each iteration (half-way to the mean of their
-  // neighbours), which shortens the border and pulls unsupported skirts in.
-  // Off by default: on the development corpus 3 rings took
-  // cheburashka-grey-nomask from 0.502x to 0.369x the input's accuracy90, but
-  // the retraction is not bounded, and on a small object refined over three
-  // levels (homer-color-small, --Refine.num_levels 3) it cost 5.4 points of
-  // completeness (docs/results.md, "Open borders: a membrane").
+  // neighbours), which shortens the border and pulls the skirt in, but only
+  // where the images see the vertex and contradict it: its mean similarity
+  // over the iteration's pairs is below 0.5 (a vertex no pixel sees is held,
+  // as is one the images agree on). Off by
+  // default: on the development corpus 3 rings took cheburashka-grey-nomask
+  // from 0.502x to 0.388x the input's accuracy90, but they made the example
+  // worse on every measure (chamfer +3 %) and the worst closed case
+  // (builtin-shading-40) 0.630x -> 0.638x (docs/results.md, "Open borders: a
+  // membrane held by the images").
   int open_border_rings = 0;
   BackgroundMaskOptions background_mask;
   // With given masks: measure where the images' edges lie across the masks'
@@ -279,6 +282,7 @@ struct RefineIteration {
   double mean_similarity = 0;  // before the step, over all valid pair pixels
   int num_pairs = 0;           // view pairs of the data term (pair_halves_min_views)
   int vertices_reset = 0;      // by the self-intersection guard after the step
+  int border_vertices_moved = 0;  // by the open border's membrane step
   double kappa = 0;
   double mean_step_px = 0;     // mean |gradient step| in pixel footprints
   double max_step_px = 0;
