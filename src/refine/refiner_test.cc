@@ -900,8 +900,7 @@ TriangleMesh FacesExcept(const Eigen::MatrixXd& V, const Eigen::MatrixXi& F,
                          const std::function<bool(const Eigen::RowVector3d&)>& cut) {
   std::vector<int> kept;
   for (int f = 0; f < F.rows(); ++f) {
-    const Eigen::RowVector3d c = (V.row(F(f, 0)) + V.row(F(f, 1)) + V.row(F(f, 2))) / 3.0;
-    if (!cut(c)) kept.push_back(f);
+    if (!cut(FaceCentroid(V, F, f).transpose())) kept.push_back(f);
   }
   TriangleMesh mesh;
   mesh.V = V;
