@@ -101,10 +101,9 @@ BackgroundModel EstimateFiltered(const cv::Mat& filtered, const BackgroundMaskOp
   });
   BackgroundModel model;
   for (int k = 0; k < 3; ++k) {
-    std::vector<double>& values = channel[k];
-    model.color[k] = Median(&values);
-    for (double& v : values) v = std::abs(v - model.color[k]);
-    model.spread = std::max(model.spread, 1.4826 * Median(&values));
+    const MedianAndSpread robust = RobustMedianAndSpread(&channel[k]);
+    model.color[k] = robust.median;
+    model.spread = std::max(model.spread, robust.sigma);
   }
   model.tolerance = std::max(options.min_tolerance, options.tolerance_sigmas * model.spread);
   long within = 0, total = 0;

@@ -48,4 +48,21 @@ T Median(std::vector<T>* values) {
   return NthSmallest(values, values->size() / 2);
 }
 
+// A sample's median and its spread as a robust standard deviation: 1.4826 x
+// the median absolute deviation from the median, which is the standard
+// deviation for normally distributed values and ignores a minority of
+// outliers. Reorders `values`, which must not be empty, and leaves them as the
+// absolute deviations.
+struct MedianAndSpread {
+  double median = 0;
+  double sigma = 0;
+};
+inline MedianAndSpread RobustMedianAndSpread(std::vector<double>* values) {
+  MedianAndSpread out;
+  out.median = Median(values);
+  for (double& v : *values) v = v > out.median ? v - out.median : out.median - v;
+  out.sigma = 1.4826 * Median(values);
+  return out;
+}
+
 }  // namespace mr

@@ -340,6 +340,23 @@ TEST(Statistics, AgreesWithSorting) {
   }
 }
 
+// The median and 1.4826 x the median absolute deviation; a minority of wild
+// values moves neither.
+TEST(Statistics, RobustMedianAndSpread) {
+  std::vector<double> values = {1, 2, 3, 4, 5};
+  MedianAndSpread robust = RobustMedianAndSpread(&values);
+  EXPECT_EQ(robust.median, 3);
+  EXPECT_DOUBLE_EQ(robust.sigma, 1.4826);  // deviations 0 1 1 2 2
+  values = {1, 2, 3, 4, 5, 1000, -1000};
+  robust = RobustMedianAndSpread(&values);
+  EXPECT_EQ(robust.median, 3);
+  EXPECT_DOUBLE_EQ(robust.sigma, 2 * 1.4826);  // deviations 0 1 1 2 2 997 1003
+  values = {4};
+  robust = RobustMedianAndSpread(&values);
+  EXPECT_EQ(robust.median, 4);
+  EXPECT_EQ(robust.sigma, 0);
+}
+
 // RunIsolated: what the child returns arrives (large answers too: more than
 // the pipe holds); a child that dies is reported with its signal; the
 // errors it throws are thrown again in the caller.
