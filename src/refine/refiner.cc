@@ -141,24 +141,17 @@ constexpr int kDecimateFacesPerPiece = 50000;
 // [-2, 0], so this is the largest explicit step that flips the sign of no
 // frequency (no zig-zag is made worse).
 constexpr double kOpenBorderStep = 0.5;
-// A band vertex takes the step only where the images see it and disagree:
-// its mean similarity over the iteration's pairs is below this. On
-// cheburashka-grey-nomask most of the band's skirt lay at 0-0.6 against a
-// median of 0.92 over the mesh; on homer-color-small, where the border lay on
-// the object, most of the band was at 0.8-1. A vertex that no pixel of the
-// pairs sees is held too: nothing says that it is wrong, and with such
-// vertices moving the example's chamfer distance rose 7 % against 3 % with
-// them held (docs/results.md, "Open borders: a membrane held by the images").
-constexpr double kOpenBorderMaxSimilarity = 0.5;
 
 // Per band vertex, 1 where the membrane step may move it (the images see it
-// and disagree: see kOpenBorderMaxSimilarity), 0 elsewhere.
-Eigen::VectorXd UnheldBandVertices(const VertexBand& band, const DataTerm& term) {
+// and disagree), 0 elsewhere; `contradicted_below` is the similarity bound
+// (ContradictedSimilarity).
+Eigen::VectorXd UnheldBandVertices(const VertexBand& band, const DataTerm& term,
+                                   double contradicted_below) {
   Eigen::VectorXd unheld(band.vertices.size());
   for (size_t i = 0; i < band.vertices.size(); ++i) {
     const int v = band.vertices[i];
     const bool contradicted = term.weight(v) > 0 &&
-                              term.similarity(v) < kOpenBorderMaxSimilarity * term.weight(v);
+                              term.similarity(v) < contradicted_below * term.weight(v);
     unheld(i) = contradicted ? 1.0 : 0.0;
   }
   return unheld;
@@ -293,6 +286,19 @@ int FirstAveragedIteration(int iterations, int average_last, int camera_rounds) 
     if (IsCameraRound(it, iterations, camera_rounds)) first = std::max(first, it + settling);
   }
   return iterations - first >= 2 ? first : iterations;
+}
+
+double ContradictedSimilarity(const Eigen::VectorXd& similarity, const Eigen::VectorXd& weight) {
+  MR_CHECK_EQ(similarity.size(), weight.size());
+  std::vector<double> mean;
+  mean.reserve(weight.size());
+  for (Eigen::Index v = 0; v < weight.size(); ++v) {
+    if (weight(v) > 0) mean.push_back(similarity(v) / weight(v));
+  }
+  if (mean.empty()) return -std::numeric_limits<double>::infinity();
+  const MedianAndSpread robust = RobustMedianAndSpread(&mean);
+  return std::min(kOpenBorderMaxSimilarity,
+                  robust.median - kOpenBorderOutlierSigmas * robust.sigma);
 }
 
 int BestIterateToKeep(const std::vector<double>& similarities, double giveback) {
@@ -1171,7 +1177,9 @@ RefineSummary RefineMesh(const ViewSource& input_source, const RefineOptions& op
         V = V_half;
       }
       if (!border_band.vertices.empty()) {
-        const Eigen::VectorXd unheld = UnheldBandVertices(border_band, term);
+        record.border_similarity_bound = ContradictedSimilarity(term.similarity, term.weight);
+        const Eigen::VectorXd unheld =
+            UnheldBandVertices(border_band, term, record.border_similarity_bound);
         record.border_vertices_moved = static_cast<int>(unheld.sum());
         MembraneStep(border_band, kOpenBorderStep, &V, &unheld);
       }
@@ -1217,7 +1225,8 @@ RefineSummary RefineMesh(const ViewSource& input_source, const RefineOptions& op
                            ? std::string()
                            : "; membrane on " + std::to_string(record.border_vertices_moved) +
                                  " of " + std::to_string(border_band.vertices.size()) +
-                                 " band vertices")
+                                 " band vertices (similarity below " +
+                                 FormatShort(record.border_similarity_bound, 2) + ")")
                    << "; " << record.seconds
                    << " s (data " << record.data_seconds << ", silhouette "
                    << record.silhouette_seconds << ", denoise " << record.denoise_seconds
@@ -1434,9 +1443,9 @@ void RegisterRefineOptions(OptionManager* o, RefineOptions* r) {
          "pixels outside a mask (the visual hull); < 0: only contour vertices");
   o->Add("Refine.open_border_rings", &r->open_border_rings,
          "at the finest level, vertices within this many edge rings of an open border that the "
-         "images see and contradict (mean similarity below 0.5) take a membrane step each "
-         "iteration, which pulls in the skirts trimmed Poisson meshes end in (1: the border "
-         "only; 0: off)");
+         "images see and contradict (mean similarity below 0.5, and 3 robust deviations below "
+         "the mesh's median) take a membrane step each iteration, which pulls in the skirts "
+         "trimmed Poisson meshes end in (1: the border only; 0: off)");
   o->Add("Refine.masks_from_background", &r->masks_from_background,
          "without masks, make them from a uniform background where they agree with the input "
          "mesh (for the silhouette term)");

@@ -4,6 +4,7 @@
 #include <cmath>
 #include <cstdio>
 #include <functional>
+#include <limits>
 #include <random>
 #include <set>
 #include <string>
@@ -208,6 +209,35 @@ TEST(MeanResetFraction, SeparatesTheShellFromAPlateau) {
   EXPECT_EQ(MeanResetFraction({}, 100), 0.0);
   EXPECT_EQ(MeanResetFraction({5}, 0), 0.0);
   EXPECT_DOUBLE_EQ(MeanResetFraction({10, 30}, 100), 0.2);
+}
+
+// A seen band vertex counts as contradicted below 0.5 on a textured surface,
+// whose vertices score near 0.92, and on a shaded one, whose vertices score
+// anywhere in [-0.2, 0.4], only well below all of them. The sums are per
+// vertex, Σ w m and Σ w; unseen vertices (w = 0) are left out.
+TEST(ContradictedSimilarity, AnOutlierOfItsOwnSurface) {
+  const int n = 1001;
+  Eigen::VectorXd weight(n), textured(n), shaded(n);
+  for (int v = 0; v < n; ++v) {
+    weight(v) = 1 + v % 5;
+    textured(v) = weight(v) * (0.92 + 0.03 * ((v % 7) - 3) / 3.0);
+    shaded(v) = weight(v) * (-0.2 + 0.6 * v / (n - 1.0));
+  }
+  EXPECT_EQ(ContradictedSimilarity(textured, weight), kOpenBorderMaxSimilarity);
+  // Median 0.1, median absolute deviation 0.15.
+  const double shaded_bound = 0.1 - kOpenBorderOutlierSigmas * 1.4826 * 0.15;
+  EXPECT_NEAR(ContradictedSimilarity(shaded, weight), shaded_bound, 1e-3);
+  EXPECT_LT(shaded_bound, -0.2);  // no vertex of the shaded surface counts
+
+  // Unseen vertices do not count, whatever their sums say.
+  Eigen::VectorXd weight_unseen = weight, shaded_unseen = shaded;
+  for (int v = 0; v < n; v += 2) {
+    weight_unseen(v) = 0;
+    shaded_unseen(v) = 0.9;
+  }
+  EXPECT_NEAR(ContradictedSimilarity(shaded_unseen, weight_unseen), shaded_bound, 0.01);
+  EXPECT_EQ(ContradictedSimilarity(shaded, Eigen::VectorXd::Zero(n)),
+            -std::numeric_limits<double>::infinity());
 }
 
 TEST_F(RefinerTest, GroundTruthStaysGroundTruth) {
