@@ -144,6 +144,12 @@ Distances Query(const std::vector<Sample>& samples, const Eigen::MatrixXd& sampl
   return result;
 }
 
+// The rank of the nearest-rank q-quantile of n > 0 values, ceil(q n) - 1,
+// which is not QuantileRank's floor(q n) (one higher whenever q n is whole).
+size_t NearestRank(size_t n, double q) {
+  return std::max<size_t>(1, static_cast<size_t>(std::ceil(q * n))) - 1;
+}
+
 double Mean(const std::vector<double>& values) {
   double sum = 0;
   for (double v : values) sum += v;
@@ -223,19 +229,58 @@ VertexErrors MeasureVertexErrors(const Eigen::MatrixXd& V, const Eigen::MatrixXd
   return errors;
 }
 
-Eigen::Matrix<uint8_t, Eigen::Dynamic, 3> ErrorColors(const VertexErrors& errors,
-                                                      double max_distance) {
-  MR_CHECK(max_distance > 0) << "max_distance " << max_distance;
+Eigen::VectorXd MeasureVertexNormalErrors(const Eigen::MatrixXd& V, const Eigen::MatrixXi& F,
+                                          const Eigen::MatrixXd& gt_V,
+                                          const Eigen::MatrixXi& gt_F) {
+  MR_CHECK(gt_F.rows() > 0) << "ground truth without faces";
+  const Eigen::MatrixXd normals = FaceNormals(V, F);
+  const Eigen::MatrixXd gt_normals = FaceNormals(gt_V, gt_F);
+  const ClosestPointQuery tree(gt_V, gt_F);
+  Eigen::VectorXi closest(V.rows());
+#ifdef _OPENMP
+#pragma omp parallel for schedule(dynamic, 1024)
+#endif
+  for (Eigen::Index v = 0; v < V.rows(); ++v) {
+    int face = -1;
+    tree.Distance(V.row(v).transpose(), &face);
+    closest(v) = face;
+  }
+  Eigen::VectorXd sum = Eigen::VectorXd::Zero(V.rows());
+  Eigen::VectorXi count = Eigen::VectorXi::Zero(V.rows());
+  for (Eigen::Index f = 0; f < F.rows(); ++f) {
+    const Eigen::Vector3d n = normals.row(f);
+    if (n.squaredNorm() < 0.5) continue;  // degenerate
+    for (int k = 0; k < 3; ++k) {
+      const int v = F(f, k);
+      const Eigen::Vector3d m = gt_normals.row(closest(v));
+      if (m.squaredNorm() < 0.5) continue;
+      sum(v) += std::acos(std::min(1.0, std::abs(n.dot(m)))) * 180.0 / M_PI;
+      ++count(v);
+    }
+  }
+  Eigen::VectorXd angles(V.rows());
+  for (Eigen::Index v = 0; v < V.rows(); ++v) {
+    angles(v) = count(v) > 0 ? sum(v) / count(v) : std::nan("");
+  }
+  return angles;
+}
+
+Eigen::Matrix<uint8_t, Eigen::Dynamic, 3> ErrorColors(const Eigen::VectorXd& values,
+                                                      const std::vector<char>& observed,
+                                                      double max_value) {
+  MR_CHECK(max_value > 0) << "max_value " << max_value;
+  MR_CHECK(static_cast<Eigen::Index>(observed.size()) == values.size())
+      << observed.size() << " observed flags for " << values.size() << " values";
   // Five stops of the viridis scale (its values at 0, 1/4, 1/2, 3/4, 1).
   static const double kStops[5][3] = {
       {68, 1, 84}, {59, 82, 139}, {33, 145, 140}, {94, 201, 98}, {253, 231, 37}};
-  Eigen::Matrix<uint8_t, Eigen::Dynamic, 3> colors(errors.distance.size(), 3);
-  for (Eigen::Index v = 0; v < errors.distance.size(); ++v) {
-    if (!errors.observed[v]) {
+  Eigen::Matrix<uint8_t, Eigen::Dynamic, 3> colors(values.size(), 3);
+  for (Eigen::Index v = 0; v < values.size(); ++v) {
+    if (!observed[v] || !std::isfinite(values(v))) {
       colors.row(v).setConstant(128);
       continue;
     }
-    const double t = 4 * std::clamp(errors.distance(v) / max_distance, 0.0, 1.0);
+    const double t = 4 * std::clamp(values(v) / max_value, 0.0, 1.0);
     const int k = std::min(3, static_cast<int>(t));
     const double w = t - k;
     for (int c = 0; c < 3; ++c) {
@@ -264,8 +309,10 @@ std::string EvaluationResult::ToJson() const {
   char text[512];
   std::snprintf(text, sizeof(text),
                 "{\"accuracy90\": %.9g, \"completeness\": %.6f, \"chamfer\": %.9g, "
-                "\"normal_deg\": %.6f, \"mean_accuracy\": %.9g, \"faces\": %d",
-                accuracy90, completeness, chamfer, normal_deg, mean_accuracy, faces);
+                "\"normal_deg\": %.6f, \"normal_deg_median\": %.6f, \"normal_deg_p90\": %.6f, "
+                "\"mean_accuracy\": %.9g, \"faces\": %d",
+                accuracy90, completeness, chamfer, normal_deg, normal_deg_median, normal_deg_p90,
+                mean_accuracy, faces);
   std::string json = text;
   if (observed_percent >= 0) {
     std::snprintf(text, sizeof(text), ", \"observed_percent\": %.3f", observed_percent);
@@ -326,25 +373,23 @@ EvaluationResult EvaluateMesh(const Eigen::MatrixXd& V, const Eigen::MatrixXi& F
   result.mean_accuracy = Mean(to_gt.distance);
   result.chamfer = result.mean_accuracy + Mean(to_recon.distance);
 
-  // The nearest-rank 90th percentile, rank ceil(0.9 n) - 1, which is not
-  // Quantile's floor(0.9 n) (one higher whenever 0.9 n is whole).
   std::vector<double> distances = to_gt.distance;
-  const size_t k = static_cast<size_t>(std::ceil(0.9 * distances.size())) - 1;
-  result.accuracy90 = NthSmallest(&distances, k);
+  result.accuracy90 = NthSmallest(&distances, NearestRank(distances.size(), 0.9));
 
   size_t within = 0;
   for (double d : to_recon.distance) within += d <= options.threshold ? 1 : 0;
   result.completeness = 100.0 * within / to_recon.distance.size();
 
-  double angle_sum = 0;
-  size_t angle_count = 0;
+  std::vector<double> angles;
+  angles.reserve(to_gt.angle_deg.size());
   for (double a : to_gt.angle_deg) {
-    if (std::isfinite(a)) {
-      angle_sum += a;
-      ++angle_count;
-    }
+    if (std::isfinite(a)) angles.push_back(a);
   }
-  result.normal_deg = angle_count > 0 ? angle_sum / angle_count : 0;
+  if (!angles.empty()) {
+    result.normal_deg = Mean(angles);
+    result.normal_deg_median = Median(&angles);
+    result.normal_deg_p90 = NthSmallest(&angles, NearestRank(angles.size(), 0.9));
+  }
   MR_LOG(VERBOSE) << "Evaluated " << F.rows() << " faces against " << gt_F.rows()
                   << " ground-truth faces with " << options.num_samples << " samples each";
   return result;

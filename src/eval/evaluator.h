@@ -31,6 +31,11 @@ struct EvaluationResult {
   // Mean angle between recon and closest-GT face normals as unoriented lines,
   // min(theta, 180 - theta): independent of either mesh's face winding.
   double normal_deg = 0;
+  // The upper median and the nearest-rank 90th percentile of the same
+  // angles: a refined surface's mean is often held up by a tail of wrong
+  // features (fingers, filled concavities) while its bulk is right.
+  double normal_deg_median = 0;
+  double normal_deg_p90 = 0;
   double mean_accuracy = 0;  // mean recon->GT distance
   int faces = 0;             // faces of the evaluated mesh
   // With an observed-face mask: % of the ground truth's area observed (the
@@ -84,11 +89,22 @@ VertexErrors MeasureVertexErrors(const Eigen::MatrixXd& V, const Eigen::MatrixXd
                                  const Eigen::MatrixXi& gt_F,
                                  const std::vector<char>* gt_observed = nullptr);
 
-// An error map's colours (RGB): the viridis scale from dark blue (0) through
-// green to yellow (`max_distance` and beyond); vertices whose closest
-// ground-truth face is not observed are mid grey. max_distance > 0.
-Eigen::Matrix<uint8_t, Eigen::Dynamic, 3> ErrorColors(const VertexErrors& errors,
-                                                      double max_distance);
+// Where a mesh is turned wrong: at each vertex of (V, F), the mean over the
+// faces around it of the angle between the face's normal and the normal of
+// the ground-truth face closest to the vertex, as unoriented lines in degrees
+// (normal_deg's measure, taken at the vertices). NaN at a vertex whose faces
+// are all degenerate, or that is in no face.
+Eigen::VectorXd MeasureVertexNormalErrors(const Eigen::MatrixXd& V, const Eigen::MatrixXi& F,
+                                          const Eigen::MatrixXd& gt_V,
+                                          const Eigen::MatrixXi& gt_F);
+
+// An error map's colours (RGB) for per-vertex `values` (distances, angles):
+// the viridis scale from dark blue (0) through green to yellow (`max_value`
+// and beyond); vertices whose closest ground-truth face is not observed, and
+// NaN values, are mid grey. max_value > 0.
+Eigen::Matrix<uint8_t, Eigen::Dynamic, 3> ErrorColors(const Eigen::VectorXd& values,
+                                                      const std::vector<char>& observed,
+                                                      double max_value);
 
 // Faces of (V, F) visible in at least `min_views` of `views`: the face's
 // centroid lies in the image and is not occluded (depth test against an EGL

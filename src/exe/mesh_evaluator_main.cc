@@ -78,9 +78,16 @@ int main(int argc, char** argv) {
                 "distance to the ground truth as its `value` and as a colour (viridis, dark blue "
                 "0 to yellow at --error_max; mid grey where the closest ground truth is not "
                 "observed); after --align_cameras, in the true world");
+    std::string error_map = "distance";
+    manager.Add("error_map", &error_map,
+                "with --output_error_path: what the map shows, `distance` (to the ground truth) "
+                "or `normal` (the normal error at each vertex: the mean over its faces of the "
+                "angle between the face's normal and that of the closest ground truth, "
+                "normal_deg's measure, in degrees)");
     manager.Add("error_max", &error_max,
-                "with --output_error_path: the distance drawn yellow, in scene units (> 0; 0 = "
-                "this mesh's accuracy90). Give two meshes the same value to compare their maps");
+                "with --output_error_path: the value drawn yellow, in scene units or degrees "
+                "(> 0; 0 = this mesh's accuracy90, or its normal_deg_p90 for --error_map "
+                "normal). Give two meshes the same value to compare their maps");
     manager.SetInputPaths([&] {
       mr::WorkspaceOptions ws_options;
       ws_options.use_masks = false;
@@ -123,6 +130,9 @@ int main(int argc, char** argv) {
       mr::CheckOutputFile("--output_error_path", output_error_path);
       if (!(error_max >= 0) || !std::isfinite(error_max)) {
         MR_THROW_INPUT << "--error_max " << error_max << ": expected >= 0 (0: the accuracy90)";
+      }
+      if (error_map != "distance" && error_map != "normal") {
+        MR_THROW_INPUT << "--error_map " << error_map << ": expected distance or normal";
       }
     }
     mr::TriangleMesh mesh = mr::ReadMesh(input_path);
@@ -179,17 +189,21 @@ int main(int argc, char** argv) {
     if (!output_error_path.empty()) {
       const mr::VertexErrors errors = mr::MeasureVertexErrors(
           mesh.V, gt.V, gt.F, observed.empty() ? nullptr : &observed);
-      // The scale's top: given, else the accuracy90 (1 for a perfect mesh).
-      const double max_distance =
-          error_max > 0 ? error_max : (result.accuracy90 > 0 ? result.accuracy90 : 1.0);
+      const bool normal = error_map == "normal";
+      // The scale's top: given, else the accuracy90 or the normal error's
+      // 90th percentile (1 for a perfect mesh).
+      const double automatic = normal ? result.normal_deg_p90 : result.accuracy90;
+      const double max_value = error_max > 0 ? error_max : (automatic > 0 ? automatic : 1.0);
       mr::TriangleMesh map;
       map.V = mesh.V;
       map.F = mesh.F;
-      map.values = errors.distance;
-      map.C = mr::ErrorColors(errors, max_distance);
+      map.values = normal ? mr::MeasureVertexNormalErrors(mesh.V, mesh.F, gt.V, gt.F)
+                          : errors.distance;
+      map.C = mr::ErrorColors(map.values, errors.observed, max_value);
       mr::WritePly(output_error_path, map);
-      MR_LOG(INFO) << "Wrote the error map " << output_error_path << " (" << map.NumVertices()
-                   << " vertices; yellow at " << max_distance << ")";
+      MR_LOG(INFO) << "Wrote the " << error_map << " error map " << output_error_path << " ("
+                   << map.NumVertices() << " vertices; yellow at " << max_value
+                   << (normal ? " degrees)" : ")");
     }
     std::cout << json << std::endl;
     return 0;
