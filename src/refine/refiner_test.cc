@@ -49,6 +49,31 @@ class RefinerTest : public ::testing::Test {
     options.num_levels = 1;
     return options;
   }
+  // The smooth unit sphere (4 subdivisions) that refinements of the bumpy
+  // sphere start from.
+  static TriangleMesh SmoothSphere() {
+    TriangleMesh sphere;
+    MakeIcosphere(4, 1.0, &sphere.V, &sphere.F);
+    return sphere;
+  }
+  // The bumpy sphere (5 subdivisions) and the ring of views of it at
+  // 160x120 and at 320x240, the larger rendered with `large_supersample`.
+  struct TwoSizes {
+    Eigen::MatrixXd V;
+    Eigen::MatrixXi F;
+    InMemoryViewSource small, large;
+  };
+  static TwoSizes BumpySphereAtTwoSizes(int large_supersample) {
+    TwoSizes scene;
+    MakeBumpySphere(5, 0.06, &scene.V, &scene.F);
+    TestSceneOptions large;
+    large.width = 320;
+    large.height = 240;
+    large.supersample = large_supersample;
+    scene.small = MakeTestScene(scene.V, scene.F, {}, {}, renderer_);
+    scene.large = MakeTestScene(scene.V, scene.F, large, {}, renderer_);
+    return scene;
+  }
   static Renderer* renderer_;
 };
 Renderer* RefinerTest::renderer_ = nullptr;
@@ -460,22 +485,13 @@ TEST_F(RefinerTest, AveragedIterationsTakeAlternateHalvesOfThePairs) {
 // where the 160x120 scene ends (a camera scaled wrongly by half a pixel
 // would leave every pair misaligned and the result far off).
 TEST_F(RefinerTest, MaxImageSizeWorksAtTheWorkingResolution) {
-  Eigen::MatrixXd V;
-  Eigen::MatrixXi F;
-  MakeBumpySphere(5, 0.06, &V, &F);
-  TestSceneOptions large;
-  large.width = 320;
-  large.height = 240;
-  large.supersample = 1;
-  const InMemoryViewSource small_source = MakeTestScene(V, F, {}, {}, renderer_);
-  const InMemoryViewSource large_source = MakeTestScene(V, F, large, {}, renderer_);
-  Eigen::MatrixXd V0;
-  Eigen::MatrixXi F0;
-  MakeIcosphere(4, 1.0, &V0, &F0);
-  const EvaluationResult before = Evaluate(V0, F0, V, F);
-  TriangleMesh at_small, at_large;
-  at_small.V = at_large.V = V0;
-  at_small.F = at_large.F = F0;
+  const TwoSizes scene = BumpySphereAtTwoSizes(1);
+  const Eigen::MatrixXd& V = scene.V;
+  const Eigen::MatrixXi& F = scene.F;
+  const InMemoryViewSource& small_source = scene.small;
+  const InMemoryViewSource& large_source = scene.large;
+  TriangleMesh at_small = SmoothSphere(), at_large = SmoothSphere();
+  const EvaluationResult before = Evaluate(at_small.V, at_small.F, V, F);
   RefineMesh(small_source, FastOptions(), &at_small, renderer_);
   RefineOptions options = FastOptions();
   options.max_image_size = 160;
@@ -504,14 +520,11 @@ TEST_F(RefinerTest, MaxImageSizeWorksAtTheWorkingResolution) {
 // instead of 46k-71k; FastOptions' 12 iterations leave the finer meshes
 // rougher: normal error 4.65, 4.29 and 3.56 degrees).
 TEST_F(RefinerTest, ViewsOfDifferentSizesRefineTogether) {
-  Eigen::MatrixXd V;
-  Eigen::MatrixXi F;
-  MakeBumpySphere(5, 0.06, &V, &F);
-  TestSceneOptions large;
-  large.width = 320;
-  large.height = 240;
-  const InMemoryViewSource small_source = MakeTestScene(V, F, {}, {}, renderer_);
-  const InMemoryViewSource large_source = MakeTestScene(V, F, large, {}, renderer_);
+  const TwoSizes scene = BumpySphereAtTwoSizes(TestSceneOptions().supersample);
+  const Eigen::MatrixXd& V = scene.V;
+  const Eigen::MatrixXi& F = scene.F;
+  const InMemoryViewSource& small_source = scene.small;
+  const InMemoryViewSource& large_source = scene.large;
   InMemoryViewSource mixed;
   for (int i = 0; i < small_source.NumViews(); ++i) {
     const InMemoryViewSource& from = i % 2 == 0 ? small_source : large_source;
@@ -519,13 +532,8 @@ TEST_F(RefinerTest, ViewsOfDifferentSizesRefineTogether) {
   }
   ASSERT_EQ(mixed.View(1).width, 320);
   ASSERT_EQ(mixed.View(2).width, 160);
-  Eigen::MatrixXd V0;
-  Eigen::MatrixXi F0;
-  MakeIcosphere(4, 1.0, &V0, &F0);
-  const EvaluationResult before = Evaluate(V0, F0, V, F);
-  TriangleMesh at_large, at_mixed;
-  at_large.V = at_mixed.V = V0;
-  at_large.F = at_mixed.F = F0;
+  TriangleMesh at_large = SmoothSphere(), at_mixed = SmoothSphere();
+  const EvaluationResult before = Evaluate(at_large.V, at_large.F, V, F);
   RefineMesh(large_source, FastOptions(), &at_large, renderer_);
   const RefineSummary summary = RefineMesh(mixed, FastOptions(), &at_mixed, renderer_);
   const EvaluationResult large_result = Evaluate(at_large.V, at_large.F, V, F);
