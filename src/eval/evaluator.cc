@@ -112,6 +112,14 @@ struct Distances {
   std::vector<int> target_face;   // per sample: the closest target triangle
 };
 
+// The angle in degrees between two unit normals as unoriented lines,
+// min(theta, 180 - theta) in [0, 90]; NaN where either is undefined (a
+// degenerate face's zero normal).
+double UnorientedAngleDeg(const Eigen::Vector3d& a, const Eigen::Vector3d& b) {
+  if (a.squaredNorm() < 0.5 || b.squaredNorm() < 0.5) return std::nan("");
+  return std::acos(std::min(1.0, std::abs(a.dot(b)))) * 180.0 / M_PI;
+}
+
 // Distance from every sample to the target mesh, and the angle between the
 // sample's face normal and the normal of the closest target triangle as
 // unoriented lines, min(theta, 180 - theta) in [0, 90] degrees: neither
@@ -132,14 +140,8 @@ Distances Query(const std::vector<Sample>& samples, const Eigen::MatrixXd& sampl
     int target_face = 0;
     result.distance[i] = tree.Distance(samples[i].point, &target_face);
     result.target_face[i] = target_face;
-    const Eigen::Vector3d a = sample_normals.row(samples[i].face);
-    const Eigen::Vector3d b = target_normals.row(target_face);
-    if (a.squaredNorm() > 0.5 && b.squaredNorm() > 0.5) {
-      const double cosine = std::min(1.0, std::abs(a.dot(b)));
-      result.angle_deg[i] = std::acos(cosine) * 180.0 / M_PI;
-    } else {
-      result.angle_deg[i] = std::nan("");
-    }
+    result.angle_deg[i] = UnorientedAngleDeg(sample_normals.row(samples[i].face).transpose(),
+                                             target_normals.row(target_face).transpose());
   }
   return result;
 }
@@ -217,6 +219,7 @@ VertexErrors MeasureVertexErrors(const Eigen::MatrixXd& V, const Eigen::MatrixXd
   VertexErrors errors;
   errors.distance.resize(V.rows());
   errors.observed.assign(V.rows(), 1);
+  errors.closest_face.resize(V.rows());
   const ClosestPointQuery tree(gt_V, gt_F);
 #ifdef _OPENMP
 #pragma omp parallel for schedule(dynamic, 1024)
@@ -224,37 +227,28 @@ VertexErrors MeasureVertexErrors(const Eigen::MatrixXd& V, const Eigen::MatrixXd
   for (Eigen::Index v = 0; v < V.rows(); ++v) {
     int face = -1;
     errors.distance(v) = tree.Distance(V.row(v).transpose(), &face);
+    errors.closest_face[v] = face;
     if (gt_observed != nullptr) errors.observed[v] = (*gt_observed)[face];
   }
   return errors;
 }
 
 Eigen::VectorXd MeasureVertexNormalErrors(const Eigen::MatrixXd& V, const Eigen::MatrixXi& F,
-                                          const Eigen::MatrixXd& gt_V,
-                                          const Eigen::MatrixXi& gt_F) {
-  MR_CHECK(gt_F.rows() > 0) << "ground truth without faces";
+                                          const Eigen::MatrixXd& gt_V, const Eigen::MatrixXi& gt_F,
+                                          const VertexErrors& errors) {
+  MR_CHECK(static_cast<Eigen::Index>(errors.closest_face.size()) == V.rows())
+      << errors.closest_face.size() << " closest faces for " << V.rows() << " vertices";
   const Eigen::MatrixXd normals = FaceNormals(V, F);
   const Eigen::MatrixXd gt_normals = FaceNormals(gt_V, gt_F);
-  const ClosestPointQuery tree(gt_V, gt_F);
-  Eigen::VectorXi closest(V.rows());
-#ifdef _OPENMP
-#pragma omp parallel for schedule(dynamic, 1024)
-#endif
-  for (Eigen::Index v = 0; v < V.rows(); ++v) {
-    int face = -1;
-    tree.Distance(V.row(v).transpose(), &face);
-    closest(v) = face;
-  }
   Eigen::VectorXd sum = Eigen::VectorXd::Zero(V.rows());
   Eigen::VectorXi count = Eigen::VectorXi::Zero(V.rows());
   for (Eigen::Index f = 0; f < F.rows(); ++f) {
-    const Eigen::Vector3d n = normals.row(f);
-    if (n.squaredNorm() < 0.5) continue;  // degenerate
     for (int k = 0; k < 3; ++k) {
       const int v = F(f, k);
-      const Eigen::Vector3d m = gt_normals.row(closest(v));
-      if (m.squaredNorm() < 0.5) continue;
-      sum(v) += std::acos(std::min(1.0, std::abs(n.dot(m)))) * 180.0 / M_PI;
+      const double angle = UnorientedAngleDeg(normals.row(f).transpose(),
+                                              gt_normals.row(errors.closest_face[v]).transpose());
+      if (std::isnan(angle)) continue;
+      sum(v) += angle;
       ++count(v);
     }
   }

@@ -84,6 +84,7 @@ SurfaceDisplacement MeasureSurfaceDisplacement(const Eigen::MatrixXd& V,
 struct VertexErrors {
   Eigen::VectorXd distance;
   std::vector<char> observed;
+  std::vector<int> closest_face;  // the ground-truth face closest to each vertex
 };
 VertexErrors MeasureVertexErrors(const Eigen::MatrixXd& V, const Eigen::MatrixXd& gt_V,
                                  const Eigen::MatrixXi& gt_F,
@@ -91,12 +92,13 @@ VertexErrors MeasureVertexErrors(const Eigen::MatrixXd& V, const Eigen::MatrixXd
 
 // Where a mesh is turned wrong: at each vertex of (V, F), the mean over the
 // faces around it of the angle between the face's normal and the normal of
-// the ground-truth face closest to the vertex, as unoriented lines in degrees
-// (normal_deg's measure, taken at the vertices). NaN at a vertex whose faces
-// are all degenerate, or that is in no face.
+// the ground-truth face closest to the vertex (`errors.closest_face`, from
+// MeasureVertexErrors on the same V and ground truth), as unoriented lines in
+// degrees (normal_deg's measure, taken at the vertices). NaN at a vertex
+// whose faces are all degenerate, or that is in no face.
 Eigen::VectorXd MeasureVertexNormalErrors(const Eigen::MatrixXd& V, const Eigen::MatrixXi& F,
-                                          const Eigen::MatrixXd& gt_V,
-                                          const Eigen::MatrixXi& gt_F);
+                                          const Eigen::MatrixXd& gt_V, const Eigen::MatrixXi& gt_F,
+                                          const VertexErrors& errors);
 
 // An error map's colours (RGB) for per-vertex `values` (distances, angles):
 // the viridis scale from dark blue (0) through green to yellow (`max_value`

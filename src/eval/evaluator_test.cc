@@ -191,6 +191,7 @@ TEST(MeasureVertexErrors, DistancesObservedFlagsAndColours) {
       1.3, 0.5, 0.4;        // beside the square: hypot(0.3, 0.4) = 0.5
   VertexErrors errors = MeasureVertexErrors(points, plane.V, plane.F);
   ASSERT_EQ(errors.distance.size(), 3);
+  ASSERT_EQ(errors.closest_face.size(), 3u);
   EXPECT_NEAR(errors.distance(0), 0.1, 1e-12);
   EXPECT_NEAR(errors.distance(1), 0.3, 1e-12);
   EXPECT_NEAR(errors.distance(2), 0.5, 1e-12);
@@ -234,7 +235,8 @@ TEST(MeasureVertexNormalErrors, MeanAngleOfTheFacesAroundEachVertex) {
   }
   folded.V.conservativeResize(folded.V.rows() + 1, 3);
   folded.V.row(folded.V.rows() - 1) << 0.5, 0.5, 2.0;  // in no face
-  const Eigen::VectorXd angles = MeasureVertexNormalErrors(folded.V, folded.F, plane.V, plane.F);
+  const Eigen::VectorXd angles = MeasureVertexNormalErrors(
+      folded.V, folded.F, plane.V, plane.F, MeasureVertexErrors(folded.V, plane.V, plane.F));
   ASSERT_EQ(angles.size(), folded.V.rows());
   for (int v = 0; v + 1 < folded.V.rows(); ++v) {
     const double x = plane.V(v, 0);

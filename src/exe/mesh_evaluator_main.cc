@@ -197,7 +197,7 @@ int main(int argc, char** argv) {
       mr::TriangleMesh map;
       map.V = mesh.V;
       map.F = mesh.F;
-      map.values = normal ? mr::MeasureVertexNormalErrors(mesh.V, mesh.F, gt.V, gt.F)
+      map.values = normal ? mr::MeasureVertexNormalErrors(mesh.V, mesh.F, gt.V, gt.F, errors)
                           : errors.distance;
       map.C = mr::ErrorColors(map.values, errors.observed, max_value);
       mr::WritePly(output_error_path, map);
