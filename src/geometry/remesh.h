@@ -106,6 +106,25 @@ SubdivisionSummary SubdivideSqrt3(Eigen::MatrixXd* V, Eigen::MatrixXi* F);
 // In place.
 SubdivisionSummary SubdivideMidpoint(Eigen::MatrixXd* V, Eigen::MatrixXi* F);
 
+// One step of 1-to-4 subdivision that keeps the old vertices and puts each
+// new one on a smooth surface through them: on the cubic edge curve of the
+// point-normal (PN) triangles of Vlachos et al. (I3D 2001), at its midpoint
+//   (a + b) / 2 - ((b - a).n_a n_a - (b - a).n_b n_b) / 8,
+// the curve through a and b tangent to the planes of the normals n_a, n_b.
+// With exact normals, a sphere's new vertices are off it by O(h^4) where
+// SubdivideMidpoint's are by h^2 / 8 (h the edge length); with a mesh's own
+// vertex normals, by a sixth of the midpoints' (an icosphere). n_a is vertex a's normal
+// seen from the edge: the area-weighted mean of the normals of a's faces,
+// each weighted by exp(-|n_f - n_e|^2 / (2 normal_sigma^2)), n_e the mean
+// normal of the edge's faces. On a crease the faces across it then barely
+// count, and the edges beside it stay flat where plain vertex normals would
+// bulge them (normal_sigma <= 0: the plain area-weighted vertex normals).
+// New vertices are appended after the old ones, vertex #V + e on edge e of
+// ComputeEdgeTopology(F). Any triangle soup (boundary and non-manifold edges
+// included). In place.
+SubdivisionSummary SubdividePointNormal(Eigen::MatrixXd* V, Eigen::MatrixXi* F,
+                                        double normal_sigma);
+
 // ---------------------------------------------------------------------------
 // Isotropic remeshing (CGAL Polygon_mesh_processing::isotropic_remeshing:
 // split long / collapse short edges, flip to valence 6, tangential relaxation).

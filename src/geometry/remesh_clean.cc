@@ -208,22 +208,28 @@ std::string SubdivisionSummary::BriefReport() const {
   return s.str();
 }
 
-SubdivisionSummary SubdivideMidpoint(Eigen::MatrixXd* V, Eigen::MatrixXi* F) {
-  MR_CHECK(V != nullptr && F != nullptr);
-  CheckMeshInput(*V, *F, "SubdivideMidpoint");
+namespace {
+
+// 1-to-4 split of every face, a new vertex per unique edge of `topo` placed
+// by `edge_point(e)` and appended after the old vertices (vertex nv + e on
+// edge e); orientation kept. Shared by the two 1-to-4 schemes below.
+template <typename EdgePoint>
+SubdivisionSummary SplitEveryEdge(const char* what, const EdgeTopology& topo,
+                                  EdgePoint edge_point, Eigen::MatrixXd* V, Eigen::MatrixXi* F) {
   const double t0 = ElapsedSeconds();
   SubdivisionSummary summary;
   summary.initial_vertices = V->rows();
   summary.initial_faces = F->rows();
   const int nv = V->rows();
-  const EdgeTopology topo = ComputeEdgeTopology(*F, nv);
   const int ne = topo.E.rows();
+  Eigen::MatrixXd points(ne, 3);
+  for (int e = 0; e < ne; ++e) points.row(e) = edge_point(e);
   V->conservativeResize(nv + ne, 3);
-  for (int e = 0; e < ne; ++e) V->row(nv + e) = 0.5 * (V->row(topo.E(e, 0)) + V->row(topo.E(e, 1)));
+  V->bottomRows(ne) = points;
   Eigen::MatrixXi F4(4 * F->rows(), 3);
   for (int f = 0; f < F->rows(); ++f) {
     const int a = (*F)(f, 0), b = (*F)(f, 1), c = (*F)(f, 2);
-    // m_k: midpoint of the edge opposite corner k.
+    // m_k: the new vertex on the edge opposite corner k.
     const int m0 = nv + topo.face_edges(f, 0), m1 = nv + topo.face_edges(f, 1),
               m2 = nv + topo.face_edges(f, 2);
     F4.row(4 * f + 0) << a, m2, m1;
@@ -236,8 +242,60 @@ SubdivisionSummary SubdivideMidpoint(Eigen::MatrixXd* V, Eigen::MatrixXi* F) {
   summary.final_vertices = V->rows();
   summary.final_faces = F->rows();
   summary.seconds = ElapsedSeconds() - t0;
-  MR_LOG(INFO) << "SubdivideMidpoint: " << summary.BriefReport();
+  MR_LOG(INFO) << what << ": " << summary.BriefReport();
   return summary;
+}
+
+}  // namespace
+
+SubdivisionSummary SubdivideMidpoint(Eigen::MatrixXd* V, Eigen::MatrixXi* F) {
+  MR_CHECK(V != nullptr && F != nullptr);
+  CheckMeshInput(*V, *F, "SubdivideMidpoint");
+  const EdgeTopology topo = ComputeEdgeTopology(*F, V->rows());
+  const Eigen::MatrixXd& X = *V;
+  return SplitEveryEdge(
+      "SubdivideMidpoint", topo,
+      [&](int e) -> Eigen::RowVector3d {
+        return 0.5 * (X.row(topo.E(e, 0)) + X.row(topo.E(e, 1)));
+      },
+      V, F);
+}
+
+SubdivisionSummary SubdividePointNormal(Eigen::MatrixXd* V, Eigen::MatrixXi* F,
+                                        double normal_sigma) {
+  MR_CHECK(V != nullptr && F != nullptr);
+  CheckMeshInput(*V, *F, "SubdividePointNormal");
+  const int nv = V->rows();
+  const EdgeTopology topo = ComputeEdgeTopology(*F, nv);
+  const IndexLists vertex_faces = VertexFaces(*F, nv);
+  const Eigen::MatrixXd N = FaceNormals(*V, *F);
+  const Eigen::VectorXd A = FaceAreas(*V, *F);
+  const double inv_2s2 = normal_sigma > 0 ? 1.0 / (2 * normal_sigma * normal_sigma) : 0.0;
+  // The normal at vertex v seen from an edge whose faces have the mean
+  // normal n_edge: v's faces by area, those turned away from n_edge (across
+  // a crease) weighted down.
+  auto normal_at = [&](int v, const Eigen::RowVector3d& n_edge) -> Eigen::RowVector3d {
+    Eigen::RowVector3d sum = Eigen::RowVector3d::Zero();
+    for (const int f : vertex_faces[v]) {
+      sum += A(f) * std::exp(-(N.row(f) - n_edge).squaredNorm() * inv_2s2) * N.row(f);
+    }
+    const double len = sum.norm();
+    return len > 0 ? Eigen::RowVector3d(sum / len) : Eigen::RowVector3d::Zero();
+  };
+  const Eigen::MatrixXd& X = *V;
+  return SplitEveryEdge(
+      "SubdividePointNormal", topo,
+      [&](int e) -> Eigen::RowVector3d {
+        const int a = topo.E(e, 0), b = topo.E(e, 1);
+        Eigen::RowVector3d n_edge = Eigen::RowVector3d::Zero();
+        for (const int f : topo.edge_faces[e]) n_edge += N.row(f);
+        if (n_edge.norm() > 0) n_edge.normalize();
+        const Eigen::RowVector3d na = normal_at(a, n_edge), nb = normal_at(b, n_edge);
+        const Eigen::RowVector3d ab = X.row(b) - X.row(a);
+        // The cubic edge curve of Vlachos et al.'s PN triangle at t = 1/2.
+        return 0.5 * (X.row(a) + X.row(b)) - (ab.dot(na) * na - ab.dot(nb) * nb) / 8.0;
+      },
+      V, F);
 }
 
 // ---------------------------------------------------------------------------
