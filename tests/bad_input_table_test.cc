@@ -304,6 +304,10 @@ std::vector<BadInput> Table() {
       {"RefinerCameraRoundsZero", R, "`--Refine.camera_rounds 0`", kNothing,
        kWs + " --Refine.camera_rounds 0", 1,
        "RefineOptions::camera_rounds = 0. Violated constraint: camera_rounds >= 1"},
+      {"RefinerOutputSubdivisionsThree", R, "`--Refine.output_subdivisions 3`", kNothing,
+       kWs + " --Refine.output_subdivisions 3", 1,
+       "RefineOptions::output_subdivisions = 3. Violated constraint: "
+       "0 <= output_subdivisions <= 2"},
       {"RefinerMaskOutlineOffsetNegative", R, "`--MaskOutline.min_offset_px -1`", kNothing,
        kWs + " --MaskOutline.min_offset_px -1", 1,
        "MaskOutlineOptions::min_offset_px = -1. Violated constraint: min_offset_px >= 0"},

@@ -606,6 +606,40 @@ std::string FormatSeconds(double s) {
   return out.str();
 }
 
+// RefineOptions::output_subdivisions, one step: SubdividePointNormal, each
+// new vertex's colour the mean of its edge's ends. With `guarded` (the mesh
+// is an oriented 2-manifold free of self-intersections), a new vertex whose
+// faces would intersect or flip goes back to its edge's midpoint, where the
+// surface is the unsplit one's.
+void SubdivideResult(double normal_sigma, bool guarded, TriangleMesh* mesh) {
+  const int nv = mesh->NumVertices();
+  const EdgeTopology topology = ComputeEdgeTopology(mesh->F, nv);
+  const Eigen::MatrixXi& E = topology.E;
+  SubdividePointNormal(&mesh->V, &mesh->F, normal_sigma);
+  if (guarded) {
+    Eigen::MatrixXd V_midpoints = mesh->V;
+    for (int e = 0; e < E.rows(); ++e) {
+      V_midpoints.row(nv + e) = 0.5 * (mesh->V.row(E(e, 0)) + mesh->V.row(E(e, 1)));
+    }
+    const UndoSelfIntersectionsSummary undone =
+        UndoSelfIntersections(V_midpoints, mesh->F, {}, &mesh->V);
+    if (undone.reset_vertices > 0) {
+      MR_LOG(INFO) << "SubdividePointNormal: " << undone.reset_vertices
+                   << " new vertices back on their edges' midpoints (" << undone.BriefReport()
+                   << ")";
+    }
+  }
+  if (mesh->C.rows() == nv) {
+    mesh->C.conservativeResize(nv + E.rows(), 3);
+    for (int e = 0; e < E.rows(); ++e) {
+      for (int k = 0; k < 3; ++k) {
+        mesh->C(nv + e, k) =
+            static_cast<uint8_t>((int{mesh->C(E(e, 0), k)} + int{mesh->C(E(e, 1), k)} + 1) / 2);
+      }
+    }
+  }
+}
+
 }  // namespace
 
 double MeanResetFraction(const std::vector<int>& resets, int num_vertices) {
@@ -638,6 +672,10 @@ bool RefineOptions::Check() const {
     fail("max_image_size", std::to_string(max_image_size), "max_image_size >= 32 or -1");
   }
   if (max_faces < 0) fail("max_faces", std::to_string(max_faces), "max_faces >= 0");
+  if (output_subdivisions < 0 || output_subdivisions > 2) {
+    fail("output_subdivisions", std::to_string(output_subdivisions),
+         "0 <= output_subdivisions <= 2");
+  }
   if (!(step > 0 && step <= 1)) fail("step", std::to_string(step), "0 < step <= 1");
   if (!(max_step_px > 0)) fail("max_step_px", std::to_string(max_step_px), "max_step_px > 0");
   if (!(damping >= 0)) fail("damping", std::to_string(damping), "damping >= 0");
@@ -1333,6 +1371,10 @@ RefineSummary RefineMesh(const ViewSource& input_source, const RefineOptions& op
   mesh->N.resize(0, 3);
   mesh->values.resize(0);
   final_pass->colors.Colors(renderer, &mesh->C);
+  for (int i = 0; i < options.output_subdivisions; ++i) {
+    SubdivideResult(options.denoise.normal_sigma,
+                    options.prevent_self_intersections && summary.self_intersections == 0, mesh);
+  }
   if (options.refine_cameras != "none") {
     // Back to the resolution of the input source (max_image_size scaled it).
     for (int i = 0; i < source.NumViews(); ++i) {
@@ -1385,6 +1427,9 @@ void RegisterRefineOptions(OptionManager* o, RefineOptions* r) {
   o->Add("Refine.target_edge_px", &r->target_edge_px,
          "target triangle edge length in pixels at each level (> 0)");
   o->Add("Refine.max_faces", &r->max_faces, "face budget (0: 2x input faces, at least 100k)");
+  o->Add("Refine.output_subdivisions", &r->output_subdivisions,
+         "the result's faces are split in four this many times, the new vertices on the "
+         "point-normal cubic curves of its edges (0..2; 0: the refined triangles as they are)");
   o->Add("Refine.step", &r->step, "fraction of the Gauss-Newton step per iteration (0, 1]");
   o->Add("Refine.max_step_px", &r->max_step_px,
          "largest vertex motion per iteration, in pixel footprints (> 0)");
