@@ -120,10 +120,12 @@ SubdivisionSummary SubdivideMidpoint(Eigen::MatrixXd* V, Eigen::MatrixXi* F);
 // count, and the edges beside it stay flat where plain vertex normals would
 // bulge them (normal_sigma <= 0: the plain area-weighted vertex normals).
 // New vertices are appended after the old ones, vertex #V + e on edge e of
-// ComputeEdgeTopology(F). Any triangle soup (boundary and non-manifold edges
-// included). In place.
+// ComputeEdgeTopology(F); `parent_edges`, when given, gets that E (#E x 2,
+// the ends of new vertex #V + e's edge). Any triangle soup (boundary and
+// non-manifold edges included). In place.
 SubdivisionSummary SubdividePointNormal(Eigen::MatrixXd* V, Eigen::MatrixXi* F,
-                                        double normal_sigma);
+                                        double normal_sigma,
+                                        Eigen::MatrixXi* parent_edges = nullptr);
 
 // ---------------------------------------------------------------------------
 // Isotropic remeshing (CGAL Polygon_mesh_processing::isotropic_remeshing:

@@ -262,7 +262,7 @@ SubdivisionSummary SubdivideMidpoint(Eigen::MatrixXd* V, Eigen::MatrixXi* F) {
 }
 
 SubdivisionSummary SubdividePointNormal(Eigen::MatrixXd* V, Eigen::MatrixXi* F,
-                                        double normal_sigma) {
+                                        double normal_sigma, Eigen::MatrixXi* parent_edges) {
   MR_CHECK(V != nullptr && F != nullptr);
   CheckMeshInput(*V, *F, "SubdividePointNormal");
   const int nv = V->rows();
@@ -283,6 +283,7 @@ SubdivisionSummary SubdividePointNormal(Eigen::MatrixXd* V, Eigen::MatrixXi* F,
     return len > 0 ? Eigen::RowVector3d(sum / len) : Eigen::RowVector3d::Zero();
   };
   const Eigen::MatrixXd& X = *V;
+  if (parent_edges != nullptr) *parent_edges = topo.E;
   return SplitEveryEdge(
       "SubdividePointNormal", topo,
       [&](int e) -> Eigen::RowVector3d {

@@ -363,11 +363,21 @@ TEST(SubdividePointNormal, KeepsAPlaneFlatAndTheSidesOfACreaseFlat) {
   Eigen::MatrixXd V_mid = V;
   Eigen::MatrixXi F_mid = F;
   SubdivideMidpoint(&V_mid, &F_mid);
-  SubdividePointNormal(&V, &F, 0.35);
+  const Eigen::MatrixXd V_flat = V;
+  Eigen::MatrixXi E;
+  SubdividePointNormal(&V, &F, 0.35, &E);
   EXPECT_LT((V - V_mid).cwiseAbs().maxCoeff(), 1e-15);
+  // Each new vertex is the midpoint of the edge it reports.
+  ASSERT_EQ(E.rows(), V.rows() - V_flat.rows());
+  for (int e = 0; e < E.rows(); ++e) {
+    EXPECT_LT((V.row(V_flat.rows() + e) - 0.5 * (V_flat.row(E(e, 0)) + V_flat.row(E(e, 1))))
+                  .norm(),
+              1e-15);
+  }
   // A ridge of 90 degrees: the faces across it weigh exp(-2 / (2 0.35^2)),
   // 3e-4, in the normals of the ridge's vertices, so the new vertices beside
-  // the ridge stay on their plane within 1e-4 edge lengths. With plain
+  // the ridge stay on their plane (measured 1.0e-4 edge lengths off; the
+  // bound is 2e-4). With plain
   // vertex normals (sigma 0) the ridge's normals lean 45 degrees off both
   // planes and the edges leaving it bulge by a twentieth of their length.
   const double h = 0.25;

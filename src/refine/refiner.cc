@@ -613,9 +613,8 @@ std::string FormatSeconds(double s) {
 // surface is the unsplit one's.
 void SubdivideResult(double normal_sigma, bool guarded, TriangleMesh* mesh) {
   const int nv = mesh->NumVertices();
-  const EdgeTopology topology = ComputeEdgeTopology(mesh->F, nv);
-  const Eigen::MatrixXi& E = topology.E;
-  SubdividePointNormal(&mesh->V, &mesh->F, normal_sigma);
+  Eigen::MatrixXi E;  // the edge of each new vertex
+  SubdividePointNormal(&mesh->V, &mesh->F, normal_sigma, &E);
   if (guarded) {
     Eigen::MatrixXd V_midpoints = mesh->V;
     for (int e = 0; e < E.rows(); ++e) {
