@@ -90,7 +90,7 @@ echo "example done after $((SECONDS - T0)) s"
 if [ "${LARGE_C:-1}" != 0 ]; then
   timed c_make_2m "$B/mesh_refiner" --workspace_path "$EX/dense" --output_path "$D/meshed-2m.ply" \
     --Refine.iterations_per_level 0 --Refine.num_levels 1 --Refine.target_edge_px 0.7 \
-    --Refine.max_faces 2200000
+    --Refine.max_faces 2200000 --Refine.output_subdivisions 0
   timed c_refine "$B/mesh_refiner" --workspace_path "$EX/dense" --input_path "$D/meshed-2m.ply" \
     --output_path "$D/c_refined.ply"
   grep -E "Decimate:|  time:" "$LOGS/c_refine.log"

@@ -63,7 +63,7 @@ for c in $cases; do
       echo "[$(date +%T)] remeshing c's Poisson mesh to about 2M faces" >&2
       "$BIN/mesh_refiner" --workspace_path "$ws/dense" --output_path "$input" \
         --Refine.iterations_per_level 0 --Refine.num_levels 1 --Refine.target_edge_px 0.7 \
-        --Refine.max_faces 2200000 > "$OUT/$c.remesh.log" 2>&1
+        --Refine.max_faces 2200000 --Refine.output_subdivisions 0 > "$OUT/$c.remesh.log" 2>&1
     fi
   fi
   [ -f "$OUT/$c.input.json" ] || evaluate "$input" > "$OUT/$c.input.json"
