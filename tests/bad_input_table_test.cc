@@ -308,6 +308,10 @@ std::vector<BadInput> Table() {
        kWs + " --Refine.output_subdivisions 3", 1,
        "RefineOptions::output_subdivisions = 3. Violated constraint: "
        "0 <= output_subdivisions <= 2"},
+      {"RefinerFairingWeightUnstable", R, "`--Denoise.fairing_weight 0.5`", kNothing,
+       kWs + " --Denoise.fairing_weight 0.5", 1,
+       "DenoiseOptions::fairing_weight = 0.5. Violated constraint: "
+       "0 <= fairing_weight < 0.5 (stability)"},
       {"RefinerMaskOutlineOffsetNegative", R, "`--MaskOutline.min_offset_px -1`", kNothing,
        kWs + " --MaskOutline.min_offset_px -1", 1,
        "MaskOutlineOptions::min_offset_px = -1. Violated constraint: min_offset_px >= 0"},

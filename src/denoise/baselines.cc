@@ -25,6 +25,25 @@ Eigen::MatrixXd Umbrella(const IndexLists& nb, const Eigen::MatrixXd& X) {
   return L;
 }
 
+// The faces sharing a vertex with each face, itself excluded (Zheng et al.'s
+// local neighbourhood).
+std::vector<std::vector<int>> FaceRings(const Eigen::MatrixXi& F, const IndexLists& vf) {
+  const int nf = static_cast<int>(F.rows());
+  std::vector<std::vector<int>> ring(nf);
+#pragma omp parallel for schedule(dynamic, 256) if (nf > 50000)
+  for (int f = 0; f < nf; ++f) {
+    std::vector<int>& r = ring[f];
+    for (int k = 0; k < 3; ++k) {
+      for (const int g : vf[F(f, k)]) {
+        if (g != f) r.push_back(g);
+      }
+    }
+    std::sort(r.begin(), r.end());
+    r.erase(std::unique(r.begin(), r.end()), r.end());
+  }
+  return ring;
+}
+
 }  // namespace
 
 Eigen::MatrixXd LaplacianSmooth(const Eigen::MatrixXd& V, const Eigen::MatrixXi& F,
@@ -125,24 +144,47 @@ Eigen::MatrixXd BilateralNormalFilter(const Eigen::MatrixXd& V, const Eigen::Mat
   const int n = static_cast<int>(V.rows()), nf = static_cast<int>(F.rows());
   if (nf == 0) return V;
   const IndexLists vf = VertexFaces(F, n);
-  // Face neighbourhoods: faces sharing a vertex (Zheng et al.'s local scheme).
-  std::vector<std::vector<int>> ring(nf);
-#pragma omp parallel for schedule(dynamic, 256) if (nf > 50000)
-  for (int f = 0; f < nf; ++f) {
-    std::vector<int>& r = ring[f];
-    for (int k = 0; k < 3; ++k) {
-      const int v = F(f, k);
-      for (const int g : vf[v]) {
-        if (g != f) r.push_back(g);
-      }
-    }
-    std::sort(r.begin(), r.end());
-    r.erase(std::unique(r.begin(), r.end()), r.end());
-  }
+  const std::vector<std::vector<int>> ring = FaceRings(F, vf);
   Eigen::MatrixXd X = V;
   for (int round = 0; round < outer_iterations; ++round) {
     BilateralNormalRound(F, vf, ring, normal_iterations, vertex_iterations, normal_sigma,
                          spatial_sigma, &X);
+  }
+  return X;
+}
+
+Eigen::MatrixXd SecondOrderFairing(const Eigen::MatrixXd& V, const Eigen::MatrixXi& F,
+                                   double weight, double normal_sigma) {
+  const int n = static_cast<int>(V.rows()), nf = static_cast<int>(F.rows());
+  if (nf == 0 || !(weight > 0)) return V;
+  const IndexLists nb = VertexAdjacency(F, n);
+  const Eigen::MatrixXd LL = Umbrella(nb, Umbrella(nb, V));
+  if (!(normal_sigma > 0)) return V - weight * LL;
+  // Each face's share of its ring that the range weight leaves out.
+  const IndexLists vf = VertexFaces(F, n);
+  const std::vector<std::vector<int>> ring = FaceRings(F, vf);
+  const Eigen::MatrixXd N = FaceNormals(V, F);
+  const double inv_2s2 = 1.0 / (2.0 * normal_sigma * normal_sigma);
+  Eigen::VectorXd left_out(nf);
+#pragma omp parallel for schedule(static) if (nf > 50000)
+  for (int f = 0; f < nf; ++f) {
+    double kept = 0;
+    for (const int g : ring[f]) kept += std::exp(-(N.row(f) - N.row(g)).squaredNorm() * inv_2s2);
+    left_out(f) = ring[f].empty() ? 0.0 : 1.0 - kept / static_cast<double>(ring[f].size());
+  }
+  // The vertex's weight ramps from 0 to 1 as its faces' mean share goes
+  // from kFairingFrom to kFairingFull.
+  constexpr double kFairingFrom = 0.15, kFairingFull = 0.4;
+  Eigen::MatrixXd X = V;
+#pragma omp parallel for schedule(static) if (n > 50000)
+  for (int v = 0; v < n; ++v) {
+    const IndexLists::List faces = vf[v];
+    if (faces.size() == 0) continue;
+    double share = 0;
+    for (const int f : faces) share += left_out(f);
+    share /= static_cast<double>(faces.size());
+    const double m = std::clamp((share - kFairingFrom) / (kFairingFull - kFairingFrom), 0.0, 1.0);
+    X.row(v) -= weight * m * LL.row(v);
   }
   return X;
 }

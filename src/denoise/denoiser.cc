@@ -229,6 +229,8 @@ bool DenoiseOptions::Check() const {
   MR_CHECK_OPTION(vertex_iterations >= 0, vertex_iterations, "vertex_iterations >= 0");
   MR_CHECK_OPTION(normal_sigma > 0, normal_sigma, "normal_sigma > 0");
   MR_CHECK_OPTION(spatial_sigma > 0, spatial_sigma, "spatial_sigma > 0");
+  MR_CHECK_OPTION(fairing_weight >= 0 && fairing_weight < 0.5, fairing_weight,
+                  "0 <= fairing_weight < 0.5 (stability)");
   MR_CHECK_OPTION(l0_lambda_factor > 0 && std::isfinite(l0_lambda_factor), l0_lambda_factor,
                   "l0_lambda_factor > 0");
   MR_CHECK_OPTION(l0_lambda >= 0 && std::isfinite(l0_lambda), l0_lambda, "l0_lambda >= 0");
@@ -297,6 +299,9 @@ DenoiseResult Denoise(const Eigen::MatrixXd& V0, const Eigen::MatrixXi& F,
     result.V = BilateralNormalFilter(V0, F, options.normal_iterations, options.vertex_iterations,
                                      options.normal_sigma, options.spatial_sigma,
                                      options.outer_iterations);
+    if (options.fairing_weight > 0) {
+      result.V = SecondOrderFairing(result.V, F, options.fairing_weight, options.normal_sigma);
+    }
   }
   result.total_seconds = Now() - t0;
   result.solve_seconds = result.total_seconds - result.setup_seconds;
@@ -351,6 +356,9 @@ void RegisterDenoiseOptions(OptionManager* m, DenoiseOptions* o, const std::stri
   m->Add(name("normal_sigma"), &o->normal_sigma, "bilateral_normal: range sigma on |n_i - n_j|");
   m->Add(name("spatial_sigma"), &o->spatial_sigma,
          "bilateral_normal: spatial sigma in mean centroid distances");
+  m->Add(name("fairing_weight"), &o->fairing_weight,
+         "bilateral_normal: then one second-order fairing step of this weight where the "
+         "filter leaves faces unfiltered (features a few edges round), [0, 0.5)");
   m->Add(name("l0_lambda_factor"), &o->l0_lambda_factor,
          "l0: lambda = this * mean edge^2 * mean dihedral angle (degrees), > 0");
   m->Add(name("l0_lambda"), &o->l0_lambda,

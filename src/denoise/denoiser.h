@@ -122,6 +122,12 @@ struct DenoiseOptions {
   double normal_sigma = 1.25;
   // Spatial sigma, in mean distances between adjacent face centroids, > 0.
   double spatial_sigma = 1.0;
+  // After the rounds, one second-order fairing step of this weight
+  // (SecondOrderFairing in baselines.h, [0, 0.5)) where the filter leaves
+  // faces unfiltered because they differ by more than normal_sigma: features
+  // a few edges round, which the filter cannot smooth. 0: none.
+  // mesh_refiner's proximal step uses 0.3 (refiner.h).
+  double fairing_weight = 0.0;
 
   // ---- l0 (He & Schaefer 2013; also uses linear_solver, cg_tolerance,
   // cg_max_iterations) ----
