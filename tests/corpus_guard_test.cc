@@ -92,6 +92,8 @@ TEST_P(CorpusGuard, DefaultsImproveTheObservedSurface) {
                                                        EvaluationOptions(), region.get());
   const EvaluationResult& b = e.input;
   const EvaluationResult& a = e.refined;
+  RecordProperty("accuracy90_ratio", std::to_string(a.accuracy90 / b.accuracy90));
+  RecordProperty("normal_ratio", std::to_string(a.normal_deg / b.normal_deg));
   EXPECT_LT(a.accuracy90, c.max_accuracy_ratio * b.accuracy90)
       << b.ToJson() << "\n" << a.ToJson() << "\n" << r.output;
   EXPECT_LT(a.normal_deg, c.max_normal_ratio * b.normal_deg) << b.ToJson() << "\n" << a.ToJson();
@@ -99,18 +101,21 @@ TEST_P(CorpusGuard, DefaultsImproveTheObservedSurface) {
   fs::remove_all(dir);
 }
 
-// Bounds: the ratios measured with the defaults on the full corpus run
-// (rocker-head-noise 0.358 / 0.686, bunny-color-hemi 0.422 / 0.760,
-// cheburashka-head 0.318 / 0.651; docs/results.md, after the silhouette
-// correction; builtin-ground, a scene in depth, 0.256 / 0.481, where one
-// edge length for the whole scene gave 0.302 / 0.549: the normal bound
-// catches that, the accuracy bound does not), plus 0.05 for run-to-run and
-// machine differences.
+// Bounds: the ratios measured with the defaults on the full corpus run of 7
+// December 2026 (docs/results.md, the corpus table: rocker-head-noise 0.270 /
+// 0.567, bunny-color-hemi 0.382 / 0.661, cheburashka-head 0.195 / 0.458,
+// builtin-ground, a scene in depth, 0.248 / 0.408), plus 0.05 for
+// run-to-run and machine differences (COLMAP's fusion and Poisson meshing
+// differ from one synthesis to the next: this test's own single-threaded
+// syntheses gave 0.263 / 0.559, 0.385 / 0.679, 0.199 / 0.463 and 0.236 /
+// 0.413 the same day, recorded as test properties). Until then the bounds
+// were those of 4 December (0.41 / 0.74, 0.47 / 0.81, 0.37 / 0.70, 0.31 /
+// 0.53), which the split and the fairing had left far behind.
 INSTANTIATE_TEST_SUITE_P(Corpus, CorpusGuard,
-                         ::testing::Values(GuardCase{"rocker-head-noise", 0.41, 0.74},
-                                           GuardCase{"bunny-color-hemi", 0.47, 0.81},
-                                           GuardCase{"cheburashka-head", 0.37, 0.70},
-                                           GuardCase{"builtin-ground", 0.31, 0.53}),
+                         ::testing::Values(GuardCase{"rocker-head-noise", 0.32, 0.62},
+                                           GuardCase{"bunny-color-hemi", 0.43, 0.71},
+                                           GuardCase{"cheburashka-head", 0.25, 0.51},
+                                           GuardCase{"builtin-ground", 0.30, 0.46}),
                          [](const ::testing::TestParamInfo<GuardCase>& info) {
                            std::string name = info.param.name;
                            for (char& ch : name) {
