@@ -135,34 +135,16 @@ void BilateralNormalRound(const Eigen::MatrixXi& F, const IndexLists& vf,
   }
 }
 
-}  // namespace
-
-Eigen::MatrixXd BilateralNormalFilter(const Eigen::MatrixXd& V, const Eigen::MatrixXi& F,
-                                      int normal_iterations, int vertex_iterations,
-                                      double normal_sigma, double spatial_sigma,
-                                      int outer_iterations) {
+// SecondOrderFairing on neighbourhoods already built: `vf` the faces of each
+// vertex, `ring` the faces sharing a vertex with each face.
+Eigen::MatrixXd FairingStep(const Eigen::MatrixXd& V, const Eigen::MatrixXi& F,
+                            const IndexLists& vf, const std::vector<std::vector<int>>& ring,
+                            double weight, double normal_sigma) {
   const int n = static_cast<int>(V.rows()), nf = static_cast<int>(F.rows());
-  if (nf == 0) return V;
-  const IndexLists vf = VertexFaces(F, n);
-  const std::vector<std::vector<int>> ring = FaceRings(F, vf);
-  Eigen::MatrixXd X = V;
-  for (int round = 0; round < outer_iterations; ++round) {
-    BilateralNormalRound(F, vf, ring, normal_iterations, vertex_iterations, normal_sigma,
-                         spatial_sigma, &X);
-  }
-  return X;
-}
-
-Eigen::MatrixXd SecondOrderFairing(const Eigen::MatrixXd& V, const Eigen::MatrixXi& F,
-                                   double weight, double normal_sigma) {
-  const int n = static_cast<int>(V.rows()), nf = static_cast<int>(F.rows());
-  if (nf == 0 || !(weight > 0)) return V;
   const IndexLists nb = VertexAdjacency(F, n);
   const Eigen::MatrixXd LL = Umbrella(nb, Umbrella(nb, V));
   if (!(normal_sigma > 0)) return V - weight * LL;
   // Each face's share of its ring that the range weight leaves out.
-  const IndexLists vf = VertexFaces(F, n);
-  const std::vector<std::vector<int>> ring = FaceRings(F, vf);
   const Eigen::MatrixXd N = FaceNormals(V, F);
   const double inv_2s2 = 1.0 / (2.0 * normal_sigma * normal_sigma);
   Eigen::VectorXd left_out(nf);
@@ -187,6 +169,33 @@ Eigen::MatrixXd SecondOrderFairing(const Eigen::MatrixXd& V, const Eigen::Matrix
     X.row(v) -= weight * m * LL.row(v);
   }
   return X;
+}
+
+}  // namespace
+
+Eigen::MatrixXd BilateralNormalFilter(const Eigen::MatrixXd& V, const Eigen::MatrixXi& F,
+                                      int normal_iterations, int vertex_iterations,
+                                      double normal_sigma, double spatial_sigma,
+                                      int outer_iterations, double fairing_weight) {
+  const int n = static_cast<int>(V.rows()), nf = static_cast<int>(F.rows());
+  if (nf == 0) return V;
+  const IndexLists vf = VertexFaces(F, n);
+  const std::vector<std::vector<int>> ring = FaceRings(F, vf);
+  Eigen::MatrixXd X = V;
+  for (int round = 0; round < outer_iterations; ++round) {
+    BilateralNormalRound(F, vf, ring, normal_iterations, vertex_iterations, normal_sigma,
+                         spatial_sigma, &X);
+    if (fairing_weight > 0) X = FairingStep(X, F, vf, ring, fairing_weight, normal_sigma);
+  }
+  return X;
+}
+
+Eigen::MatrixXd SecondOrderFairing(const Eigen::MatrixXd& V, const Eigen::MatrixXi& F,
+                                   double weight, double normal_sigma) {
+  const int n = static_cast<int>(V.rows());
+  if (F.rows() == 0 || !(weight > 0)) return V;
+  const IndexLists vf = VertexFaces(F, n);
+  return FairingStep(V, F, vf, FaceRings(F, vf), weight, normal_sigma);
 }
 
 }  // namespace mr

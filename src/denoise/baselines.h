@@ -20,11 +20,14 @@ Eigen::MatrixXd LaplacianSmooth(const Eigen::MatrixXd& V, const Eigen::MatrixXi&
 // centroids and areas recomputed from the updated vertices each time (so
 // that two outer iterations are the filter applied twice). `spatial_sigma`
 // is in mean distances between the centroids of faces sharing a vertex, taken
-// from the input; `normal_sigma` acts on |n_i - n_j|.
+// from the input; `normal_sigma` acts on |n_i - n_j|. With a
+// `fairing_weight` > 0 each outer iteration ends with one SecondOrderFairing
+// step of that weight and normal_sigma, on the neighbourhoods the filter
+// built.
 Eigen::MatrixXd BilateralNormalFilter(const Eigen::MatrixXd& V, const Eigen::MatrixXi& F,
                                       int normal_iterations, int vertex_iterations,
                                       double normal_sigma, double spatial_sigma,
-                                      int outer_iterations = 1);
+                                      int outer_iterations = 1, double fairing_weight = 0);
 
 // One second-order fairing step X <- X - weight m L(L X), L the umbrella
 // operator (L X = mean of the one-ring - X). A surface of constant

@@ -298,10 +298,7 @@ DenoiseResult Denoise(const Eigen::MatrixXd& V0, const Eigen::MatrixXi& F,
   } else {
     result.V = BilateralNormalFilter(V0, F, options.normal_iterations, options.vertex_iterations,
                                      options.normal_sigma, options.spatial_sigma,
-                                     options.outer_iterations);
-    if (options.fairing_weight > 0) {
-      result.V = SecondOrderFairing(result.V, F, options.fairing_weight, options.normal_sigma);
-    }
+                                     options.outer_iterations, options.fairing_weight);
   }
   result.total_seconds = Now() - t0;
   result.solve_seconds = result.total_seconds - result.setup_seconds;
@@ -357,8 +354,9 @@ void RegisterDenoiseOptions(OptionManager* m, DenoiseOptions* o, const std::stri
   m->Add(name("spatial_sigma"), &o->spatial_sigma,
          "bilateral_normal: spatial sigma in mean centroid distances");
   m->Add(name("fairing_weight"), &o->fairing_weight,
-         "bilateral_normal: then one second-order fairing step of this weight where the "
-         "filter leaves faces unfiltered (features a few edges round), [0, 0.5)");
+         "bilateral_normal: each round ends with one second-order fairing step of this "
+         "weight where the filter leaves faces unfiltered (features a few edges round), "
+         "[0, 0.5)");
   m->Add(name("l0_lambda_factor"), &o->l0_lambda_factor,
          "l0: lambda = this * mean edge^2 * mean dihedral angle (degrees), > 0");
   m->Add(name("l0_lambda"), &o->l0_lambda,

@@ -17,13 +17,23 @@
 namespace mr {
 namespace {
 
-double MeanAngleDeg(const Eigen::MatrixXd& A, const Eigen::MatrixXd& B, const Eigen::MatrixXi& F) {
+// The mean angle between the face normals of A and B over the faces whose
+// vertices all lie in `keep`.
+double MeanAngleDegWhere(const Eigen::MatrixXd& A, const Eigen::MatrixXd& B,
+                         const Eigen::MatrixXi& F, const std::function<bool(int)>& keep) {
   const Eigen::MatrixXd NA = FaceNormals(A, F), NB = FaceNormals(B, F);
   double sum = 0;
+  int count = 0;
   for (int f = 0; f < F.rows(); ++f) {
-    sum += std::acos(std::max(-1.0, std::min(1.0, NA.row(f).dot(NB.row(f))))) * 180 / M_PI;
+    if (!keep(F(f, 0)) || !keep(F(f, 1)) || !keep(F(f, 2))) continue;
+    sum += std::acos(std::clamp(NA.row(f).dot(NB.row(f)), -1.0, 1.0)) * 180 / M_PI;
+    ++count;
   }
-  return sum / F.rows();
+  return sum / count;
+}
+
+double MeanAngleDeg(const Eigen::MatrixXd& A, const Eigen::MatrixXd& B, const Eigen::MatrixXi& F) {
+  return MeanAngleDegWhere(A, B, F, [](int) { return true; });
 }
 
 void NoisyCube(Eigen::MatrixXd* clean, Eigen::MatrixXd* noisy, Eigen::MatrixXi* F) {
@@ -266,9 +276,6 @@ TEST(Denoise, BaselinesReduceNoise) {
   EXPECT_LT(MeanAngleDeg(Denoise(noisy, F, o).V, clean, F), 0.3 * before);
 }
 
-// Zheng et al.'s outer iterations recompute the face normals, centroids and
-// areas from the vertices the last one fitted: k outer iterations are the
-// one-round filter applied k times.
 // An open tube along z of `around` vertices per ring (radius 1) and `rings`
 // rings, each ring turned by half a step so that the triangles are nearly
 // equilateral; outward-oriented.
@@ -291,21 +298,6 @@ void Tube(int around, int rings, Eigen::MatrixXd* V, Eigen::MatrixXi* F) {
       F->row(f++) << b, d, c;
     }
   }
-}
-
-// The mean angle between the face normals of A and B over the faces whose
-// vertices all lie in `keep`.
-double MeanAngleDegWhere(const Eigen::MatrixXd& A, const Eigen::MatrixXd& B,
-                         const Eigen::MatrixXi& F, const std::function<bool(int)>& keep) {
-  const Eigen::MatrixXd NA = FaceNormals(A, F), NB = FaceNormals(B, F);
-  double sum = 0;
-  int count = 0;
-  for (int f = 0; f < F.rows(); ++f) {
-    if (!keep(F(f, 0)) || !keep(F(f, 1)) || !keep(F(f, 2))) continue;
-    sum += std::acos(std::clamp(NA.row(f).dot(NB.row(f)), -1.0, 1.0)) * 180 / M_PI;
-    ++count;
-  }
-  return sum / count;
 }
 
 // The fairing of the refiner's proximal step (range sigma 0.35, weight 0.3).
@@ -356,6 +348,9 @@ TEST(SecondOrderFairing, LeavesASmoothSphereAndSmoothsAThinTube) {
   EXPECT_NEAR(mean_radius(X), 1.0, 0.04);
 }
 
+// Zheng et al.'s outer iterations recompute the face normals, centroids and
+// areas from the vertices the last one fitted: k outer iterations are the
+// one-round filter applied k times.
 TEST(BilateralNormalFilter, OuterIterationsApplyTheRoundAgain) {
   Eigen::MatrixXd clean, noisy;
   Eigen::MatrixXi F;
@@ -365,6 +360,24 @@ TEST(BilateralNormalFilter, OuterIterationsApplyTheRoundAgain) {
   for (int k = 0; k < 3; ++k) once = BilateralNormalFilter(once, F, 1, 4, 0.8, 1.0, 1);
   EXPECT_LT((three - once).cwiseAbs().maxCoeff(), 1e-12);
   EXPECT_GT((three - BilateralNormalFilter(noisy, F, 1, 4, 0.8, 1.0, 1)).cwiseAbs().maxCoeff(),
+            1e-4);
+}
+
+// The filter's fairing_weight ends each outer iteration with
+// SecondOrderFairing, on the same neighbourhoods: the same vertices to the
+// last bit as the round and the step called one after the other.
+TEST(BilateralNormalFilter, FairingWeightEndsEachRoundWithTheFairingStep) {
+  Eigen::MatrixXd clean, noisy;
+  Eigen::MatrixXi F;
+  NoisyCube(&clean, &noisy, &F);
+  const Eigen::MatrixXd faired = BilateralNormalFilter(noisy, F, 2, 4, 0.35, 1.0, 2, 0.3);
+  Eigen::MatrixXd by_hand = noisy;
+  for (int round = 0; round < 2; ++round) {
+    by_hand = SecondOrderFairing(BilateralNormalFilter(by_hand, F, 2, 4, 0.35, 1.0, 1), F, 0.3,
+                                 0.35);
+  }
+  EXPECT_EQ((faired - by_hand).cwiseAbs().maxCoeff(), 0.0);
+  EXPECT_GT((faired - BilateralNormalFilter(noisy, F, 2, 4, 0.35, 1.0, 2)).cwiseAbs().maxCoeff(),
             1e-4);
 }
 

@@ -1485,11 +1485,14 @@ void RegisterRefineOptions(OptionManager* o, RefineOptions* r) {
   o->Add("Refine.hull_margin_px", &r->hull_margin_px,
          "with the silhouette term: pull back every vertex that projects more than this many "
          "pixels outside a mask (the visual hull); < 0: only contour vertices");
+  std::ostringstream contradicted;
+  contradicted << "mean similarity below " << kOpenBorderMaxSimilarity << ", and "
+               << kOpenBorderOutlierSigmas << " robust deviations below the mesh's median";
   o->Add("Refine.open_border_rings", &r->open_border_rings,
          "at the finest level, vertices within this many edge rings of an open border that the "
-         "images see and contradict (mean similarity below 0.5, and 3 robust deviations below "
-         "the mesh's median) take a membrane step each iteration, which pulls in the skirts "
-         "trimmed Poisson meshes end in (1: the border only; 0: off)");
+         "images see and contradict (" + contradicted.str() + ") take a membrane step each "
+         "iteration, which pulls in the skirts trimmed Poisson meshes end in (1: the border "
+         "only; 0: off)");
   o->Add("Refine.masks_from_background", &r->masks_from_background,
          "without masks, make them from a uniform background where they agree with the input "
          "mesh (for the silhouette term)");

@@ -1291,24 +1291,18 @@ TEST_F(RefinerTest, InvariantToRotationAndScale) {
   Eigen::MatrixXd V;
   Eigen::MatrixXi F;
   MakeBumpySphere(5, 0.06, &V, &F);
-  Eigen::MatrixXd V0;
-  Eigen::MatrixXi F0;
-  MakeIcosphere(4, 1.0, &V0, &F0);
   RefineOptions options = OneLevelOptions();
   options.iterations_per_level = 4;
 
-  TriangleMesh plain;
-  plain.V = V0;
-  plain.F = F0;
+  TriangleMesh plain = SmoothSphere();
   RefineMesh(MakeTestScene(V, F, {}, {}, renderer_), options, &plain, renderer_);
 
   SceneTransform moved;
   moved.scale = 37.0;
   moved.rotation = Eigen::AngleAxisd(0.7, Eigen::Vector3d(1, 2, 3).normalized()).toRotationMatrix();
   moved.translation = Eigen::Vector3d(100, -20, 5);
-  TriangleMesh transformed;
-  transformed.V = moved.Apply(V0);
-  transformed.F = F0;
+  TriangleMesh transformed = SmoothSphere();
+  transformed.V = moved.Apply(transformed.V);
   RefineMesh(MakeTestScene(V, F, {}, moved, renderer_), options, &transformed, renderer_);
 
   // Compare in the canonical frame, as surfaces (remeshing may pick different
