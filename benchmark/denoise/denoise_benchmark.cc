@@ -88,7 +88,8 @@ class Metric {
 
 // Experiment-only overrides of the lp options from the environment (MAXIT,
 // FIXP, PMIN, PMAX, ELEXP, LSCALE, BMAX, B0, FIXL, BF, UPDOP, ESTIT, INNER, CGTOL, SOLVER) and of
-// the l0 options (L0LF, L0B0, L0BMAX, L0K, L0AF, L0AD, L0UPD); unset =
+// the l0 options (L0LF, L0B0, L0BMAX, L0K, L0AF, L0AD, L0UPD) and of the
+// bilateral_normal ones (BNOUT, BNNI, BNVI, BNSR, BNFAIR); unset =
 // defaults. Results in docs/ use none.
 void ApplyEnvOverrides(mr::DenoiseOptions* o) {
   auto env = [](const char* name, double fallback) {
@@ -120,6 +121,7 @@ void ApplyEnvOverrides(mr::DenoiseOptions* o) {
   o->normal_iterations = static_cast<int>(env("BNNI", o->normal_iterations));
   o->vertex_iterations = static_cast<int>(env("BNVI", o->vertex_iterations));
   o->normal_sigma = env("BNSR", o->normal_sigma);
+  o->fairing_weight = env("BNFAIR", o->fairing_weight);
   o->l0_update_operator = env("L0UPD", o->l0_update_operator ? 1 : 0) != 0;
 }
 
