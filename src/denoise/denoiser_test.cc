@@ -405,6 +405,29 @@ TEST(Denoise, BilateralNormalDefaultsBeatLaplacianAtAnyCountOnTheBunny) {
   EXPECT_NEAR(e_laplacian_best, 6.27, 0.05);  // the benchmark's oracle figure
 }
 
+// The fairing step's weight in mesh_denoiser (0.45) was chosen on the
+// benchmark's beast, the one model it moves (docs/denoising.md): a guard that
+// it keeps that gain, with the benchmark's noise (0.3 mean edges along the
+// normals, seed 1): 16.18 degrees without it, 14.39 with it, the Laplacian at
+// its default 10 iterations 15.03.
+TEST(Denoise, BilateralNormalFairingBringsTheBeastBelowLaplacian) {
+  const TriangleMesh beast = ReadMesh(MR_SHARED_DIR "/data/models/beast.obj");
+  const Eigen::MatrixXd noisy =
+      AddNormalNoise(beast.V, beast.F, 0.3 * MeanEdgeLength(beast.V, beast.F), 1);
+  DenoiseOptions bilateral;
+  bilateral.method = "bilateral_normal";
+  const double e_faired = MeanAngleDeg(Denoise(noisy, beast.F, bilateral).V, beast.V, beast.F);
+  bilateral.fairing_weight = 0;
+  const double e_unfaired = MeanAngleDeg(Denoise(noisy, beast.F, bilateral).V, beast.V, beast.F);
+  DenoiseOptions laplacian;
+  laplacian.method = "laplacian";
+  const double e_laplacian = MeanAngleDeg(Denoise(noisy, beast.F, laplacian).V, beast.V, beast.F);
+  RecordProperty("faired_deg", std::to_string(e_faired));
+  RecordProperty("unfaired_deg", std::to_string(e_unfaired));
+  EXPECT_LT(e_faired, 0.95 * e_unfaired);
+  EXPECT_LT(e_faired, e_laplacian);
+}
+
 TEST(Denoise, RotationTranslationAndScaleInvariant) {
   Eigen::MatrixXd clean, noisy;
   Eigen::MatrixXi F;
