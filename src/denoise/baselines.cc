@@ -135,13 +135,14 @@ void BilateralNormalRound(const Eigen::MatrixXi& F, const IndexLists& vf,
   }
 }
 
-// SecondOrderFairing on neighbourhoods already built: `vf` the faces of each
-// vertex, `ring` the faces sharing a vertex with each face.
+// SecondOrderFairing on neighbourhoods already built: `nb` the neighbours of
+// each vertex, `vf` its faces, `ring` the faces sharing a vertex with each
+// face.
 Eigen::MatrixXd FairingStep(const Eigen::MatrixXd& V, const Eigen::MatrixXi& F,
-                            const IndexLists& vf, const std::vector<std::vector<int>>& ring,
-                            double weight, double normal_sigma) {
+                            const IndexLists& nb, const IndexLists& vf,
+                            const std::vector<std::vector<int>>& ring, double weight,
+                            double normal_sigma) {
   const int n = static_cast<int>(V.rows()), nf = static_cast<int>(F.rows());
-  const IndexLists nb = VertexAdjacency(F, n);
   const Eigen::MatrixXd LL = Umbrella(nb, Umbrella(nb, V));
   if (!(normal_sigma > 0)) return V - weight * LL;
   // Each face's share of its ring that the range weight leaves out.
@@ -181,11 +182,12 @@ Eigen::MatrixXd BilateralNormalFilter(const Eigen::MatrixXd& V, const Eigen::Mat
   if (nf == 0) return V;
   const IndexLists vf = VertexFaces(F, n);
   const std::vector<std::vector<int>> ring = FaceRings(F, vf);
+  const IndexLists nb = fairing_weight > 0 ? VertexAdjacency(F, n) : IndexLists();
   Eigen::MatrixXd X = V;
   for (int round = 0; round < outer_iterations; ++round) {
     BilateralNormalRound(F, vf, ring, normal_iterations, vertex_iterations, normal_sigma,
                          spatial_sigma, &X);
-    if (fairing_weight > 0) X = FairingStep(X, F, vf, ring, fairing_weight, normal_sigma);
+    if (fairing_weight > 0) X = FairingStep(X, F, nb, vf, ring, fairing_weight, normal_sigma);
   }
   return X;
 }
@@ -195,7 +197,7 @@ Eigen::MatrixXd SecondOrderFairing(const Eigen::MatrixXd& V, const Eigen::Matrix
   const int n = static_cast<int>(V.rows());
   if (F.rows() == 0 || !(weight > 0)) return V;
   const IndexLists vf = VertexFaces(F, n);
-  return FairingStep(V, F, vf, FaceRings(F, vf), weight, normal_sigma);
+  return FairingStep(V, F, VertexAdjacency(F, n), vf, FaceRings(F, vf), weight, normal_sigma);
 }
 
 }  // namespace mr
