@@ -492,6 +492,11 @@ TEST_F(MeshRefinerCli, RefinedCamerasAreWrittenBesideTheModel) {
   ASSERT_EQ(r.exit_code, 0) << r.output;
   EXPECT_NE(r.output.find("Level 0 cameras: Camera refinement (poses)"), std::string::npos)
       << r.output;
+  // Two iterations leave room for the first of the default's two rounds only.
+  EXPECT_NE(r.output.find("Cameras refined (poses) after iteration 1 of 2; later rounds would "
+                          "fall past the last"),
+            std::string::npos)
+      << r.output;
   EXPECT_NE(r.output.find("Wrote the refined cameras to " + dir_ + "/sparse_refined"),
             std::string::npos)
       << r.output;

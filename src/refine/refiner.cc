@@ -274,16 +274,19 @@ double MedianPositive(const Eigen::VectorXd& x) {
 
 bool IsCameraRound(int it, int iterations, int rounds) {
   for (int k = 1; k <= rounds; ++k) {
-    if (it == k * iterations / (rounds + 1)) return true;
+    const int at = k * (k + 1) / 2;
+    if (at >= iterations) break;
+    if (it == at) return true;
   }
   return false;
 }
 
 int FirstAveragedIteration(int iterations, int average_last, int camera_rounds) {
-  const int settling = std::max(0, iterations - average_last);
-  int first = settling;
-  for (int it = 1; camera_rounds > 0 && it < iterations; ++it) {
-    if (IsCameraRound(it, iterations, camera_rounds)) first = std::max(first, it + settling);
+  int first = std::max(0, iterations - average_last);
+  for (int it = 1; it < iterations; ++it) {
+    if (IsCameraRound(it, iterations, camera_rounds)) {
+      first = std::max(first, it + kCameraSettlingIterations);
+    }
   }
   return iterations - first >= 2 ? first : iterations;
 }
@@ -1004,6 +1007,19 @@ RefineSummary RefineMesh(const ViewSource& input_source, const RefineOptions& op
     RenderCache renders(renderer, views, cache_bytes / 2);
     MR_LOG(INFO) << "Level " << level << ": " << views[0].width << "x" << views[0].height
                  << " images, " << F.rows() << " faces";
+    if (level == 0 && options.refine_cameras != "none") {
+      std::ostringstream at;
+      int made = 0;
+      for (int it = 1; it < options.iterations_per_level; ++it) {
+        if (IsCameraRound(it, options.iterations_per_level, options.camera_rounds)) {
+          at << (made++ ? ", " : "") << it;
+        }
+      }
+      MR_LOG(INFO) << "Cameras refined (" << options.refine_cameras << ") after iteration"
+                   << (made == 1 ? " " : "s ") << (made ? at.str() : "(none)") << " of "
+                   << options.iterations_per_level
+                   << (made < options.camera_rounds ? "; later rounds would fall past the last" : "");
+    }
     // Only at the finest level: at the coarser ones the images hold less and
     // the edges are longer, and over the coarse levels of a far-off start the
     // border retracted into the observed surface (cheburashka-grey-nomask
@@ -1064,11 +1080,11 @@ RefineSummary RefineMesh(const ViewSource& input_source, const RefineOptions& op
                          : 0.0;
       similarity.kappa = record.kappa;
 
-      // The cameras are refined only within the finest level, halfway (or
-      // camera_rounds times, evenly spaced), against the surface its first
-      // iterations made: never against the input mesh or a coarse level's
-      // surface, whose errors the images cannot tell from the cameras'. At
-      // the coarser levels' starts too (the schedule until 5 December 2026),
+      // The cameras are refined only within the finest level, after 1, 3,
+      // 6, ... of its iterations (IsCameraRound), against the surface they
+      // made: never against the input mesh or a coarse level's surface,
+      // whose errors the images cannot tell from the cameras'. At the
+      // coarser levels' starts too (the schedule until 5 December 2026),
       // COLMAP's cameras of templeSparseRing, 0.21 px from their tracks, were
       // pulled off and the held-out photo-consistency fell from 0.625 to
       // 0.443 (0.612 finest only; docs/camera_refinement.md).
@@ -1451,11 +1467,10 @@ void RegisterRefineOptions(OptionManager* o, RefineOptions* r) {
          "bilateral_normal (normals filtered, vertices fitted), lp (content-aware L_p), laplacian "
          "or none");
   o->Add("Refine.refine_cameras", &r->refine_cameras,
-         "photometric camera refinement halfway through the finest level: none, poses, "
-         "poses_intrinsics");
+         "photometric camera refinement within the finest level: none, poses, poses_intrinsics");
   o->Add("Refine.camera_rounds", &r->camera_rounds,
-         "with refine_cameras: refinements within the finest level, evenly spaced (>= 1; 1: "
-         "halfway; 2 for cameras known to be off by a pixel or more, at more cost)");
+         "with refine_cameras: refinements within the finest level, after 1, 3, 6, 10, ... of its "
+         "iterations (>= 1; rounds past its last iteration are not made)");
   o->Add("CameraRefinement.max_samples_per_pair", &r->camera_refinement.max_samples_per_pair,
          "pixels sampled per ordered view pair (>= 1)");
   o->Add("CameraRefinement.intensity_sigma", &r->camera_refinement.intensity_sigma,

@@ -186,25 +186,24 @@ struct RefineOptions {
   // relief off), "laplacian" (1st+2nd order, the isotropic baseline), or
   // "none".
   std::string regularizer = "bilateral_normal";
-  // Photometric refinement of the cameras against the current mesh halfway
-  // through the finest level (camera_rounds times, evenly spaced;
-  // camera_refinement.h), with priors centred on
+  // Photometric refinement of the cameras against the current mesh within
+  // the finest level (camera_rounds times, IsCameraRound; camera_refinement.h), with priors centred on
   // the input cameras: "none", "poses" (rotation and centre of every view)
   // or "poses_intrinsics" (also fx, fy, cx, cy, shared by the views of one
   // camera). The level's images of all views are held at once for it; a
   // level whose images would take more than half of cache_mb is not refined
   // (logged). Default "none": on the corpus it helps where the cameras are
-  // 0.5-2 px off, but with exact cameras it costs 1-3.5 % of accuracy90 and
+  // 0.5-2 px off, but with exact cameras it costs 0-4 % of accuracy90 and
   // on COLMAP's own cameras of templeSparseRing it lowers the held-out
-  // photo-consistency a little (0.625 -> 0.612; docs/camera_refinement.md).
+  // photo-consistency a little (docs/camera_refinement.md).
   std::string refine_cameras = "none";
-  // How often refine_cameras refines them within the finest level, at evenly
-  // spaced iterations (>= 1; 1: halfway). Measured after the datum alignment
-  // at 1 px of pose error (docs/camera_refinement.md): 2 brings
-  // builtin-contrast and rocker-head-noise from 1.135x and 1.263x to 1.069x
-  // and 1.140x the exact-camera run, at the price of a second refinement;
-  // the shading-only fandisk-shading gains little (1.275x -> 1.253x).
-  int camera_rounds = 1;
+  // How often refine_cameras refines them within the finest level: after 1,
+  // 3, 6, ... surface iterations (IsCameraRound; >= 1). The placement was
+  // chosen at 1 px of pose error on four corpus cases. Two rounds keep the
+  // example within +25 % of wall time (+24 %) and the cameras within 0.15 px
+  // of the truth at 1 px; three are more accurate at every level of camera
+  // error but cost +44 % (docs/camera_refinement.md, thirty-second session).
+  int camera_rounds = 2;
   CameraRefinementOptions camera_refinement;  // its mode follows refine_cameras
   // lp proximal step: estimate the noise to remove from what the gradient
   // step added (D applied to the step) instead of from the whole surface,
@@ -318,15 +317,22 @@ struct RefineIteration {
 };
 
 // Whether the finest level refines the cameras before iteration `it` of
-// `iterations` (camera_rounds): `rounds` times, evenly spaced (1: halfway).
+// `iterations` (camera_rounds): round k comes after k (k + 1) / 2 surface
+// iterations (1, 3, 6, 10, ...), so the first comes as soon as the surface
+// has taken one step from the input mesh, and the surface has one iteration
+// longer to follow each round than the one before. Rounds that would fall at
+// or after the last iteration are not made.
 bool IsCameraRound(int it, int iterations, int rounds);
+
+// Iterations after a camera round in which the surface follows the new
+// cameras before average_last_iterates may average its iterates.
+constexpr int kCameraSettlingIterations = 4;
 
 // The first iteration of the finest level whose iterate average_last_iterates
 // averages, with all after it (`iterations` when fewer than two would be):
-// the last `average_last` of `iterations`, less the first iterations -
-// average_last after the last camera round (`camera_rounds` 0: none), in
-// which the surface settles again. The mean of a surface still moving lags
-// behind it.
+// the last `average_last` of `iterations`, and none of the
+// kCameraSettlingIterations after the last camera round (`camera_rounds` 0:
+// none). The mean of a surface still moving lags behind it.
 int FirstAveragedIteration(int iterations, int average_last, int camera_rounds);
 
 // Which iterate of a level to keep. `similarities[k]` is the mean

@@ -192,10 +192,10 @@ TEST(BestIterateToKeep, KeepsTheBestOnlyWhenMuchOfTheGainWasGivenBack) {
 // after its best iterate; the baseline on fandisk-shading, whose similarity
 // also gave back half its gain while the surface kept improving, 0.2 % of
 // 29,791.
-// camera_rounds: evenly spaced rounds within the finest level's iterations,
-// never before its first iteration while there are more iterations than
-// rounds.
-TEST(IsCameraRound, EvenlySpacedRounds) {
+// camera_rounds: round k after k (k + 1) / 2 iterations of the finest
+// level, never before its first iteration; rounds that would fall at or
+// after its last iteration are not made.
+TEST(IsCameraRound, EachRoundOneIterationLaterThanTheGapBefore) {
   auto rounds_of = [](int iterations, int rounds) {
     std::vector<int> at;
     for (int it = 0; it < iterations; ++it) {
@@ -203,30 +203,27 @@ TEST(IsCameraRound, EvenlySpacedRounds) {
     }
     return at;
   };
-  EXPECT_EQ(rounds_of(10, 1), std::vector<int>({5}));
-  EXPECT_EQ(rounds_of(10, 2), std::vector<int>({3, 6}));
-  EXPECT_EQ(rounds_of(10, 3), std::vector<int>({2, 5, 7}));
-  EXPECT_EQ(rounds_of(10, 0), std::vector<int>());
-  EXPECT_EQ(rounds_of(4, 1), std::vector<int>({2}));
-  for (int iterations = 2; iterations <= 20; ++iterations) {
-    for (int rounds = 1; rounds < iterations; ++rounds) {
-      const std::vector<int> at = rounds_of(iterations, rounds);
-      EXPECT_EQ(static_cast<int>(at.size()), rounds) << iterations << " iterations, " << rounds;
-      EXPECT_GT(at.front(), 0) << iterations << " iterations, " << rounds;
-    }
-  }
+  EXPECT_EQ(rounds_of(14, 1), std::vector<int>({1}));
+  EXPECT_EQ(rounds_of(14, 2), std::vector<int>({1, 3}));
+  EXPECT_EQ(rounds_of(14, 3), std::vector<int>({1, 3, 6}));
+  EXPECT_EQ(rounds_of(14, 4), std::vector<int>({1, 3, 6, 10}));
+  EXPECT_EQ(rounds_of(14, 5), std::vector<int>({1, 3, 6, 10}));  // 15 is past the last
+  EXPECT_EQ(rounds_of(6, 3), std::vector<int>({1, 3}));           // 6 is past the last
+  EXPECT_EQ(rounds_of(14, 0), std::vector<int>());
+  EXPECT_EQ(rounds_of(1, 3), std::vector<int>());
 }
 
 // The defaults' 14 iterations average the last 8; after a camera round the
-// surface first settles for 6 iterations again.
+// surface first follows the new cameras for kCameraSettlingIterations (4).
 TEST(FirstAveragedIteration, LastIteratesAfterTheSurfaceSettled) {
+  EXPECT_EQ(kCameraSettlingIterations, 4);
   EXPECT_EQ(FirstAveragedIteration(14, 8, 0), 6);
   EXPECT_EQ(FirstAveragedIteration(14, 1, 0), 14);   // one iterate: no mean
   EXPECT_EQ(FirstAveragedIteration(4, 8, 0), 0);     // at most all of them
-  EXPECT_EQ(FirstAveragedIteration(14, 12, 1), 9);   // round at 7, 2 to settle
-  EXPECT_EQ(FirstAveragedIteration(14, 8, 1), 14);   // 13 alone: no mean
-  EXPECT_EQ(FirstAveragedIteration(14, 8, 2), 14);   // rounds at 4 and 9
-  EXPECT_EQ(FirstAveragedIteration(20, 16, 2), 17);  // rounds at 6 and 13
+  EXPECT_EQ(FirstAveragedIteration(14, 8, 1), 6);    // round at 1: settled by 5
+  EXPECT_EQ(FirstAveragedIteration(14, 8, 3), 10);   // rounds at 1, 3 and 6
+  EXPECT_EQ(FirstAveragedIteration(14, 8, 4), 14);   // the last at 10: none left
+  EXPECT_EQ(FirstAveragedIteration(11, 8, 3), 11);   // 10 alone after 6: no mean
 }
 
 TEST(MeanResetFraction, SeparatesTheShellFromAPlateau) {
@@ -755,8 +752,9 @@ TEST_F(RefinerTest, CameraRefinementUndoesPoseError) {
   const RefineSummary with = RefineMesh(wrong, options, &refined, renderer_);
   ASSERT_EQ(with.cameras.size(), true_views.size()) << with.FullReport();
   EXPECT_TRUE(without.cameras.empty());
-  // One level: halfway through it only (never against the start mesh).
-  ASSERT_EQ(with.camera_reports.size(), 1u);
+  // One level of 6 iterations: the default's two rounds, after 1 and 3
+  // iterations, never against the start mesh.
+  ASSERT_EQ(with.camera_reports.size(), 2u) << with.FullReport();
   const double error_after = ReprojectionRmsPx(true_views, with.cameras, V);
   const EvaluationResult a = Evaluate(fixed.V, fixed.F, V, F), b = Evaluate(refined.V, refined.F, V, F);
   std::printf("pose error %.3f -> %.3f px; accuracy90 %.4f without, %.4f with camera refinement; "
@@ -768,22 +766,24 @@ TEST_F(RefinerTest, CameraRefinementUndoesPoseError) {
   EXPECT_LT(b.accuracy90, a.accuracy90);
   EXPECT_GT(with.final_similarity, without.final_similarity);
 
-  // camera_rounds 2: two refinements in the level, the second from where the
-  // first left the cameras (its priors still centred on the input ones).
-  options.camera_rounds = 2;
-  TriangleMesh twice;
-  twice.V = V;
-  twice.F = F;
-  const RefineSummary two = RefineMesh(wrong, options, &twice, renderer_);
-  ASSERT_EQ(two.camera_reports.size(), 2u) << two.FullReport();
-  const double error_two = ReprojectionRmsPx(true_views, two.cameras, V);
-  std::printf("two camera rounds: pose error %.3f -> %.3f px, accuracy90 %.4f\n", error_before,
-              error_two, Evaluate(twice.V, twice.F, V, F).accuracy90);
-  EXPECT_LT(error_two, error_after) << two.camera_reports[1];  // 0.342 -> 0.292 px
+  // camera_rounds 1: a single refinement, after the first iteration. It
+  // undoes as much here (0.230 px against the default's 0.241; its second
+  // round starts from where the first left the cameras, its priors still
+  // centred on the input ones); the corpus's cases at 1 px gain from the
+  // later rounds (docs/camera_refinement.md).
+  options.camera_rounds = 1;
+  TriangleMesh once;
+  once.V = V;
+  once.F = F;
+  const RefineSummary one = RefineMesh(wrong, options, &once, renderer_);
+  ASSERT_EQ(one.camera_reports.size(), 1u) << one.FullReport();
+  const double error_one = ReprojectionRmsPx(true_views, one.cameras, V);
+  std::printf("one camera round: pose error %.3f -> %.3f px, accuracy90 %.4f\n", error_before,
+              error_one, Evaluate(once.V, once.F, V, F).accuracy90);
+  EXPECT_LT(error_one, 0.4 * error_before) << one.camera_reports[0];
 
   // Two levels: still only within the finest one, never at the coarse
   // level's surface.
-  options.camera_rounds = 1;
   options.num_levels = 2;
   TriangleMesh levels;
   levels.V = V;
