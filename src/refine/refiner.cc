@@ -272,21 +272,19 @@ double MedianPositive(const Eigen::VectorXd& x) {
 
 }  // namespace
 
-bool IsCameraRound(int it, int iterations, int rounds) {
-  for (int k = 1; k <= rounds; ++k) {
-    const int at = k * (k + 1) / 2;
-    if (at >= iterations) break;
-    if (it == at) return true;
+std::vector<int> CameraRoundIterations(int iterations, int rounds) {
+  std::vector<int> at;
+  for (int k = 1; k <= rounds && k * (k + 1) / 2 < iterations; ++k) {
+    at.push_back(k * (k + 1) / 2);
   }
-  return false;
+  return at;
 }
 
-int FirstAveragedIteration(int iterations, int average_last, int camera_rounds) {
+int FirstAveragedIteration(int iterations, int average_last,
+                           const std::vector<int>& camera_rounds) {
   int first = std::max(0, iterations - average_last);
-  for (int it = 1; it < iterations; ++it) {
-    if (IsCameraRound(it, iterations, camera_rounds)) {
-      first = std::max(first, it + kCameraSettlingIterations);
-    }
+  if (!camera_rounds.empty()) {
+    first = std::max(first, camera_rounds.back() + kCameraSettlingIterations);
   }
   return iterations - first >= 2 ? first : iterations;
 }
@@ -1007,18 +1005,23 @@ RefineSummary RefineMesh(const ViewSource& input_source, const RefineOptions& op
     RenderCache renders(renderer, views, cache_bytes / 2);
     MR_LOG(INFO) << "Level " << level << ": " << views[0].width << "x" << views[0].height
                  << " images, " << F.rows() << " faces";
+    // The finest level's camera rounds: before these iterations.
+    const std::vector<int> camera_rounds =
+        level == 0 && options.refine_cameras != "none"
+            ? CameraRoundIterations(options.iterations_per_level, options.camera_rounds)
+            : std::vector<int>();
     if (level == 0 && options.refine_cameras != "none") {
       std::ostringstream at;
-      int made = 0;
-      for (int it = 1; it < options.iterations_per_level; ++it) {
-        if (IsCameraRound(it, options.iterations_per_level, options.camera_rounds)) {
-          at << (made++ ? ", " : "") << it;
-        }
+      for (size_t k = 0; k < camera_rounds.size(); ++k) {
+        at << (k ? ", " : "") << camera_rounds[k];
       }
       MR_LOG(INFO) << "Cameras refined (" << options.refine_cameras << ") after iteration"
-                   << (made == 1 ? " " : "s ") << (made ? at.str() : "(none)") << " of "
+                   << (camera_rounds.size() == 1 ? " " : "s ")
+                   << (camera_rounds.empty() ? "(none)" : at.str()) << " of "
                    << options.iterations_per_level
-                   << (made < options.camera_rounds ? "; later rounds would fall past the last" : "");
+                   << (static_cast<int>(camera_rounds.size()) < options.camera_rounds
+                           ? "; later rounds would fall past the last"
+                           : "");
     }
     // Only at the finest level: at the coarser ones the images hold less and
     // the edges are longer, and over the coarse levels of a far-off start the
@@ -1041,8 +1044,7 @@ RefineSummary RefineMesh(const ViewSource& input_source, const RefineOptions& op
     // iterations and no mean).
     const int average_from =
         level == 0 ? FirstAveragedIteration(options.iterations_per_level,
-                                            options.average_last_iterates,
-                                            options.refine_cameras != "none" ? options.camera_rounds : 0)
+                                            options.average_last_iterates, camera_rounds)
                    : options.iterations_per_level;
     const bool averages = options.iterations_per_level - average_from >= 2;
     // Whether iteration k of the level uses all pairs. The averaged
@@ -1081,15 +1083,14 @@ RefineSummary RefineMesh(const ViewSource& input_source, const RefineOptions& op
       similarity.kappa = record.kappa;
 
       // The cameras are refined only within the finest level, after 1, 3,
-      // 6, ... of its iterations (IsCameraRound), against the surface they
+      // 6, ... of its iterations (camera_rounds), against the surface they
       // made: never against the input mesh or a coarse level's surface,
       // whose errors the images cannot tell from the cameras'. At the
       // coarser levels' starts too (the schedule until 5 December 2026),
       // COLMAP's cameras of templeSparseRing, 0.21 px from their tracks, were
       // pulled off and the held-out photo-consistency fell from 0.625 to
       // 0.443 (0.612 finest only; docs/camera_refinement.md).
-      if (options.refine_cameras != "none" && level == 0 && it > 0 &&
-          IsCameraRound(it, options.iterations_per_level, options.camera_rounds)) {
+      if (std::find(camera_rounds.begin(), camera_rounds.end(), it) != camera_rounds.end()) {
         RefineCamerasAtLevel(options, pairs, V, F, level, camera_of_view, renderer,
                              cache_bytes / 2, full_views, &images, &views, &cameras, &summary);
         level_similarities.clear();  // measured through other cameras

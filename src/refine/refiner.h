@@ -187,23 +187,24 @@ struct RefineOptions {
   // "none".
   std::string regularizer = "bilateral_normal";
   // Photometric refinement of the cameras against the current mesh within
-  // the finest level (camera_rounds times, IsCameraRound; camera_refinement.h), with priors centred on
-  // the input cameras: "none", "poses" (rotation and centre of every view)
-  // or "poses_intrinsics" (also fx, fy, cx, cy, shared by the views of one
-  // camera). The level's images of all views are held at once for it; a
-  // level whose images would take more than half of cache_mb is not refined
-  // (logged). Default "none": on the corpus it helps where the cameras are
-  // 0.5-2 px off, but with exact cameras it costs 0-4 % of accuracy90 and
-  // on COLMAP's own cameras of templeSparseRing it lowers the held-out
-  // photo-consistency a little (docs/camera_refinement.md).
+  // the finest level (camera_rounds times, CameraRoundIterations;
+  // camera_refinement.h), with priors centred on the input cameras: "none",
+  // "poses" (rotation and centre of every view) or "poses_intrinsics" (also
+  // fx, fy, cx, cy, shared by the views of one camera). The level's images
+  // of all views are held at once for it; a level whose images would take
+  // more than half of cache_mb is not refined (logged). Default "none": on
+  // the corpus it helps where the cameras are 0.5-2 px off, but with exact
+  // cameras it costs 0-4 % of accuracy90 and on COLMAP's own cameras of
+  // templeSparseRing it lowers the held-out photo-consistency a little
+  // (docs/camera_refinement.md).
   std::string refine_cameras = "none";
   // How often refine_cameras refines them within the finest level: after 1,
-  // 3, 6, ... surface iterations (IsCameraRound; >= 1). The placement was
-  // chosen at 1 px of pose error on four corpus cases. Two rounds keep the
-  // example within +25 % of wall time (+24 %) and the cameras within 0.15 px
-  // of the truth at 1 px; three lower the worst accuracy90 at every level of
-  // camera error but cost +47 % (docs/camera_refinement.md, thirty-second
-  // session).
+  // 3, 6, ... surface iterations (CameraRoundIterations; >= 1). The
+  // placement was chosen at 1 px of pose error on four corpus cases. Two
+  // rounds keep the example within +25 % of wall time (+24 %) and the
+  // cameras within 0.15 px of the truth at 1 px; three lower the worst
+  // accuracy90 at every level of camera error but cost +47 %
+  // (docs/camera_refinement.md, thirty-second session).
   int camera_rounds = 2;
   CameraRefinementOptions camera_refinement;  // its mode follows refine_cameras
   // lp proximal step: estimate the noise to remove from what the gradient
@@ -317,13 +318,14 @@ struct RefineIteration {
   double seconds = 0;
 };
 
-// Whether the finest level refines the cameras before iteration `it` of
-// `iterations` (camera_rounds): round k comes after k (k + 1) / 2 surface
-// iterations (1, 3, 6, 10, ...), so the first comes as soon as the surface
-// has taken one step from the input mesh, and the surface has one iteration
-// longer to follow each round than the one before. Rounds that would fall at
-// or after the last iteration are not made.
-bool IsCameraRound(int it, int iterations, int rounds);
+// The iterations of the finest level (of `iterations`) before which the
+// cameras are refined, for camera_rounds = `rounds`: round k comes after
+// k (k + 1) / 2 surface iterations (1, 3, 6, 10, ...), so the first comes as
+// soon as the surface has taken one step from the input mesh, and the
+// surface has one iteration longer to follow each round than the one before.
+// Rounds that would fall at or after the last iteration are not made, so the
+// list may be shorter than `rounds`.
+std::vector<int> CameraRoundIterations(int iterations, int rounds);
 
 // Iterations after a camera round in which the surface follows the new
 // cameras before average_last_iterates may average its iterates.
@@ -332,9 +334,11 @@ constexpr int kCameraSettlingIterations = 4;
 // The first iteration of the finest level whose iterate average_last_iterates
 // averages, with all after it (`iterations` when fewer than two would be):
 // the last `average_last` of `iterations`, and none of the
-// kCameraSettlingIterations after the last camera round (`camera_rounds` 0:
-// none). The mean of a surface still moving lags behind it.
-int FirstAveragedIteration(int iterations, int average_last, int camera_rounds);
+// kCameraSettlingIterations after the last of `camera_rounds`
+// (CameraRoundIterations; empty without camera refinement). The mean of a
+// surface still moving lags behind it.
+int FirstAveragedIteration(int iterations, int average_last,
+                           const std::vector<int>& camera_rounds);
 
 // Which iterate of a level to keep. `similarities[k]` is the mean
 // similarity of the level's mesh after k iterations (k = 0: its start), the

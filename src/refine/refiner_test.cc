@@ -195,35 +195,30 @@ TEST(BestIterateToKeep, KeepsTheBestOnlyWhenMuchOfTheGainWasGivenBack) {
 // camera_rounds: round k after k (k + 1) / 2 iterations of the finest
 // level, never before its first iteration; rounds that would fall at or
 // after its last iteration are not made.
-TEST(IsCameraRound, EachRoundOneIterationLaterThanTheGapBefore) {
-  auto rounds_of = [](int iterations, int rounds) {
-    std::vector<int> at;
-    for (int it = 0; it < iterations; ++it) {
-      if (IsCameraRound(it, iterations, rounds)) at.push_back(it);
-    }
-    return at;
-  };
-  EXPECT_EQ(rounds_of(14, 1), std::vector<int>({1}));
-  EXPECT_EQ(rounds_of(14, 2), std::vector<int>({1, 3}));
-  EXPECT_EQ(rounds_of(14, 3), std::vector<int>({1, 3, 6}));
-  EXPECT_EQ(rounds_of(14, 4), std::vector<int>({1, 3, 6, 10}));
-  EXPECT_EQ(rounds_of(14, 5), std::vector<int>({1, 3, 6, 10}));  // 15 is past the last
-  EXPECT_EQ(rounds_of(6, 3), std::vector<int>({1, 3}));           // 6 is past the last
-  EXPECT_EQ(rounds_of(14, 0), std::vector<int>());
-  EXPECT_EQ(rounds_of(1, 3), std::vector<int>());
+TEST(CameraRoundIterations, EachRoundOneIterationLaterThanTheGapBefore) {
+  using Rounds = std::vector<int>;
+  EXPECT_EQ(CameraRoundIterations(14, 1), Rounds({1}));
+  EXPECT_EQ(CameraRoundIterations(14, 2), Rounds({1, 3}));
+  EXPECT_EQ(CameraRoundIterations(14, 3), Rounds({1, 3, 6}));
+  EXPECT_EQ(CameraRoundIterations(14, 4), Rounds({1, 3, 6, 10}));
+  EXPECT_EQ(CameraRoundIterations(14, 5), Rounds({1, 3, 6, 10}));  // 15 is past the last
+  EXPECT_EQ(CameraRoundIterations(6, 3), Rounds({1, 3}));           // 6 is past the last
+  EXPECT_EQ(CameraRoundIterations(14, 0), Rounds());
+  EXPECT_EQ(CameraRoundIterations(1, 3), Rounds());
 }
 
 // The defaults' 14 iterations average the last 8; after a camera round the
 // surface first follows the new cameras for kCameraSettlingIterations (4).
 TEST(FirstAveragedIteration, LastIteratesAfterTheSurfaceSettled) {
   EXPECT_EQ(kCameraSettlingIterations, 4);
-  EXPECT_EQ(FirstAveragedIteration(14, 8, 0), 6);
-  EXPECT_EQ(FirstAveragedIteration(14, 1, 0), 14);   // one iterate: no mean
-  EXPECT_EQ(FirstAveragedIteration(4, 8, 0), 0);     // at most all of them
-  EXPECT_EQ(FirstAveragedIteration(14, 8, 1), 6);    // round at 1: settled by 5
-  EXPECT_EQ(FirstAveragedIteration(14, 8, 3), 10);   // rounds at 1, 3 and 6
-  EXPECT_EQ(FirstAveragedIteration(14, 8, 4), 14);   // the last at 10: none left
-  EXPECT_EQ(FirstAveragedIteration(11, 8, 3), 11);   // 10 alone after 6: no mean
+  const std::vector<int> none;
+  EXPECT_EQ(FirstAveragedIteration(14, 8, none), 6);
+  EXPECT_EQ(FirstAveragedIteration(14, 1, none), 14);  // one iterate: no mean
+  EXPECT_EQ(FirstAveragedIteration(4, 8, none), 0);    // at most all of them
+  EXPECT_EQ(FirstAveragedIteration(14, 8, {1}), 6);    // round at 1: settled by 5
+  EXPECT_EQ(FirstAveragedIteration(14, 8, {1, 3, 6}), 10);
+  EXPECT_EQ(FirstAveragedIteration(14, 8, {1, 3, 6, 10}), 14);  // none left
+  EXPECT_EQ(FirstAveragedIteration(11, 8, {1, 3, 6}), 11);  // 10 alone after 6: no mean
 }
 
 TEST(MeanResetFraction, SeparatesTheShellFromAPlateau) {
