@@ -396,46 +396,51 @@ struct BenchmarkModel {
   Eigen::MatrixXd noisy;
 };
 
+// The Laplacian's best E_a over the iteration counts around its benchmark
+// optimum (6 on bunny and beast): the oracle column of denoise_benchmark.
+double LaplacianOracleDeg(const BenchmarkModel& model) {
+  DenoiseOptions laplacian;
+  laplacian.method = "laplacian";
+  double best = 1e9;
+  for (int iterations : {2, 4, 6, 8, 10, 15}) {
+    laplacian.laplacian_iterations = iterations;
+    best = std::min(best, model.ErrorDeg(laplacian));
+  }
+  return best;
+}
+
 // The bilateral_normal defaults were chosen on the denoising benchmark's
 // organic models (docs/denoising.md); a guard that they keep what they were
 // chosen for: on the Stanford bunny with the benchmark's noise (0.3 mean
 // edges along the normals, seed 1) they beat Laplacian smoothing at every
-// iteration count around its best (6: 6.27 degrees; the defaults 5.99).
+// iteration count around its best (6: 6.27 degrees; the defaults 5.91).
 TEST(Denoise, BilateralNormalDefaultsBeatLaplacianAtAnyCountOnTheBunny) {
   const BenchmarkModel bunny("stanford-bunny.obj");
   DenoiseOptions bilateral;
   bilateral.method = "bilateral_normal";
-  const double e_bilateral = bunny.ErrorDeg(bilateral);
-  double e_laplacian_best = 1e9;
-  DenoiseOptions laplacian;
-  laplacian.method = "laplacian";
-  for (int iterations : {2, 4, 6, 8, 10, 15}) {
-    laplacian.laplacian_iterations = iterations;
-    e_laplacian_best = std::min(e_laplacian_best, bunny.ErrorDeg(laplacian));
-  }
-  EXPECT_LT(e_bilateral, e_laplacian_best);
+  const double e_laplacian_best = LaplacianOracleDeg(bunny);
+  EXPECT_LT(bunny.ErrorDeg(bilateral), e_laplacian_best);
   EXPECT_NEAR(e_laplacian_best, 6.27, 0.05);  // the benchmark's oracle figure
 }
 
-// The fairing step's weight in mesh_denoiser (0.45) was chosen on the
-// benchmark's beast, the one model it moves (docs/denoising.md): a guard that
-// it keeps that gain, with the benchmark's noise (0.3 mean edges along the
-// normals, seed 1): 16.18 degrees without it, 14.39 with it, the Laplacian at
-// its default 10 iterations 15.03.
-TEST(Denoise, BilateralNormalFairingBringsTheBeastBelowLaplacian) {
+// The beast, the benchmark's hardest organic model (faces a factor 40 apart
+// in size, the noise larger than the smallest), with the same noise: the
+// defaults beat the Laplacian at its best count too (13.66 against 13.92
+// degrees), and only through the fairing step (19.25 degrees without it).
+TEST(Denoise, BilateralNormalDefaultsBeatLaplacianAtAnyCountOnTheBeast) {
   const BenchmarkModel beast("beast.obj");
   DenoiseOptions bilateral;
   bilateral.method = "bilateral_normal";
   const double e_faired = beast.ErrorDeg(bilateral);
   bilateral.fairing_weight = 0;
   const double e_unfaired = beast.ErrorDeg(bilateral);
-  DenoiseOptions laplacian;
-  laplacian.method = "laplacian";
-  const double e_laplacian = beast.ErrorDeg(laplacian);
+  const double e_laplacian_best = LaplacianOracleDeg(beast);
   RecordProperty("faired_deg", std::to_string(e_faired));
   RecordProperty("unfaired_deg", std::to_string(e_unfaired));
-  EXPECT_LT(e_faired, 0.95 * e_unfaired);
-  EXPECT_LT(e_faired, e_laplacian);
+  RecordProperty("laplacian_best_deg", std::to_string(e_laplacian_best));
+  EXPECT_LT(e_faired, 0.8 * e_unfaired);
+  EXPECT_LT(e_faired, e_laplacian_best);
+  EXPECT_NEAR(e_laplacian_best, 13.92, 0.05);  // the benchmark's oracle figure
 }
 
 TEST(Denoise, RotationTranslationAndScaleInvariant) {
