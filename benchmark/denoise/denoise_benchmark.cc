@@ -32,6 +32,7 @@
 #include "denoise/lp_model.h"
 #include "denoise/synthetic_meshes.h"
 #include "geometry/mesh.h"
+#include "geometry/primitives.h"
 #include "util/error.h"
 #include "util/logging.h"
 #include "util/program.h"
@@ -164,6 +165,13 @@ int Quality(const std::string& models_dir, const std::string& only, const std::s
     Model o{"octahedron-5", {}, {}};
     mr::SubdividedOctahedron(5, &o.V, &o.F);
     models.push_back(o);
+  }
+  if (only == "icosphere-4" || only == "icosphere-5") {
+    // Regular spheres, `one` mode only (not in the table): where more
+    // smoothing is always better.
+    Model ico{only, {}, {}};
+    mr::MakeIcosphere(only == "icosphere-4" ? 4 : 5, 1.0, &ico.V, &ico.F);
+    models.push_back(ico);
   }
   std::printf(
       "| model | faces | noisy E_a | noisy E_v | lp E_a | lp E_v | lp s | laplacian(10) E_a | "
