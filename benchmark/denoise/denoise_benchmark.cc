@@ -218,8 +218,8 @@ int Quality(const std::string& models_dir, const std::string& only, const std::s
         // Laplacian's iteration counts.
         std::printf("%s laplacian_best: noisy E_a %.2f E_v %.2e ->", m.name.c_str(), en.ea, en.ev);
         std::pair<double, int> best{1e9, 0};
+        o.method = "laplacian";
         for (int iters : kLaplacianIterationCounts) {
-          o.method = "laplacian";
           o.laplacian_iterations = iters;
           best = std::min(best, {metric.Evaluate(mr::Denoise(noisy, m.F, o).V, m.F).ea, iters});
         }

@@ -1006,11 +1006,12 @@ RefineSummary RefineMesh(const ViewSource& input_source, const RefineOptions& op
     MR_LOG(INFO) << "Level " << level << ": " << views[0].width << "x" << views[0].height
                  << " images, " << F.rows() << " faces";
     // The finest level's camera rounds: before these iterations.
+    const bool refines_cameras = level == 0 && options.refine_cameras != "none";
     const std::vector<int> camera_rounds =
-        level == 0 && options.refine_cameras != "none"
+        refines_cameras
             ? CameraRoundIterations(options.iterations_per_level, options.camera_rounds)
             : std::vector<int>();
-    if (level == 0 && options.refine_cameras != "none") {
+    if (refines_cameras) {
       std::ostringstream at;
       for (size_t k = 0; k < camera_rounds.size(); ++k) {
         at << (k ? ", " : "") << camera_rounds[k];
