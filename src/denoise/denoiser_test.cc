@@ -349,26 +349,16 @@ TEST(SecondOrderFairing, LeavesASmoothSphereAndSmoothsAThinTube) {
   EXPECT_NEAR(mean_radius(X), 1.0, 0.04);
 }
 
-// A sheet of `n` x `n` squares over [-1, 1]^2, each split in two, folded
-// along x = 0 (a grid line) by `fold_deg` degrees: z = -tan(fold / 2) |x|.
+// A sheet of `n` x `n` squares over [-1, 1]^2 (AppendGrid), folded along
+// x = 0 (a grid line for even n) by `fold_deg` degrees:
+// z = -tan(fold / 2) |x|.
 void FoldedSheet(int n, double fold_deg, Eigen::MatrixXd* V, Eigen::MatrixXi* F) {
+  V->resize(0, 3);
+  F->resize(0, 3);
+  AppendGrid(Eigen::Vector3d(-1, -1, 0), Eigen::Vector3d(2, 0, 0), Eigen::Vector3d(0, 2, 0), n, V,
+             F);
   const double slope = std::tan(fold_deg * M_PI / 360.0);
-  V->resize((n + 1) * (n + 1), 3);
-  for (int j = 0; j <= n; ++j) {
-    for (int i = 0; i <= n; ++i) {
-      const double x = -1.0 + 2.0 * i / n, y = -1.0 + 2.0 * j / n;
-      V->row(j * (n + 1) + i) << x, y, -slope * std::abs(x);
-    }
-  }
-  F->resize(2 * n * n, 3);
-  int f = 0;
-  for (int j = 0; j < n; ++j) {
-    for (int i = 0; i < n; ++i) {
-      const int a = j * (n + 1) + i, b = a + 1, c = a + n + 1, d = c + 1;
-      F->row(f++) << a, b, d;
-      F->row(f++) << a, d, c;
-    }
-  }
+  V->col(2) = -slope * V->col(0).cwiseAbs();
 }
 
 // The faces beside a sharp crease differ from half of their ring by more
