@@ -31,6 +31,7 @@
 // The photometric Jacobian is analytic (see docs/camera_refinement.md).
 
 #include <Eigen/Core>
+#include <ceres/iteration_callback.h>
 #include <map>
 #include <opencv2/core.hpp>
 #include <string>
@@ -249,6 +250,22 @@ ceres::CostFunction* NewCameraSetDatumCost(const std::vector<Eigen::Matrix3d>& R
                                            const std::vector<Eigen::Vector3d>& C0,
                                            double sigma_center, double sigma_rotation,
                                            double sigma_scale);
+
+// A Ceres callback that ends the solve, on its last accepted iterate, at the
+// first rejected step after an accepted step that lowered the cost by less
+// than `below` of it (relative to the cost before that step). Levenberg-
+// Marquardt would otherwise shrink its trust region through one rejected
+// step after another, each a full linear solve, before function_tolerance
+// stops it on the same iterate.
+class StopOnRejectedStep : public ceres::IterationCallback {
+ public:
+  explicit StopOnRejectedStep(double below);
+  ceres::CallbackReturnType operator()(const ceres::IterationSummary& summary) override;
+
+ private:
+  double below_;
+  double last_decrease_ = 1.0;
+};
 
 }  // namespace internal
 }  // namespace mr
