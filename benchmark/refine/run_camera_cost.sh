@@ -64,12 +64,11 @@ runs = {}
 for line in open(sys.argv[1]):
     k, label, seconds = line.rstrip("\n").split("\t")
     runs.setdefault((int(k), label), []).append(float(seconds))
-reference = None
-for (k, label), seconds in sorted(runs.items()):
+configs = sorted(runs.items())
+reference = statistics.median(configs[0][1])
+for (k, label), seconds in configs:
     median = statistics.median(seconds)
-    if reference is None:
-        reference = median
-    over = "" if median == reference and k == 1 else f"{100 * (median / reference - 1):+.1f} %"
+    over = "" if k == 1 else f"{100 * (median / reference - 1):+.1f} %"
     listed = ", ".join(f"{s:.2f}" for s in seconds)
     print(f"| {label} | {listed} | {median:.2f} | {over} |")
 EOF
