@@ -6,6 +6,7 @@
 #include <iomanip>
 #include <map>
 #include <memory>
+#include <set>
 #include <sstream>
 #include <thread>
 #include <unordered_map>
@@ -555,6 +556,10 @@ bool CameraRefinementOptions::Check() const {
     MR_THROW_INPUT << "CameraRefinementOptions::max_iterations = " << max_iterations
                    << ". Violated constraint: max_iterations >= 1";
   }
+  if (max_render_mb < 1) {
+    MR_THROW_INPUT << "CameraRefinementOptions::max_render_mb = " << max_render_mb
+                   << ". Violated constraint: max_render_mb >= 1";
+  }
   return true;
 }
 
@@ -682,34 +687,60 @@ struct OrderedPair {
   std::vector<internal::PhotometricSample> samples;
 };
 
+// Bytes of a render of `view` (face id, depth and barycentric coordinates).
+size_t RenderBytes(const PinholeView& view) {
+  return size_t(view.width) * view.height *
+         (sizeof(int32_t) + sizeof(float) + 2 * sizeof(float));
+}
+
 // Renders the views in `pairs` through the mesh (footprints into
 // `footprint`) and picks the samples of both orders of every pair; ordered
-// pairs without samples are left out.
+// pairs without samples are left out. The pairs are taken in their order, in
+// batches of consecutive pairs whose views' renders take at most
+// `max_render_bytes` (at least one pair a batch); a batch keeps the renders
+// of the one before that it shares, and drops the others.
 std::vector<OrderedPair> CollectSamples(const std::vector<cv::Mat>& gray_images,
                                         const std::vector<std::pair<int, int>>& pairs,
                                         const Eigen::MatrixXd& V, const Eigen::MatrixXi& F,
                                         Renderer* renderer, const std::vector<PinholeView>& views,
-                                        int max_samples, std::vector<double>* footprint) {
-  const int num_views = static_cast<int>(views.size());
-  const std::vector<char> involved = ViewsInPairs(pairs, num_views);
+                                        int max_samples, size_t max_render_bytes,
+                                        std::vector<double>* footprint) {
   renderer->SetMesh(V, F);
-  std::vector<RenderBuffers> renders(num_views);
-  for (int i = 0; i < num_views; ++i) {
-    if (!involved[i]) continue;
-    renders[i] = renderer->Render(views[i]);
-    (*footprint)[i] = MedianFootprint(views[i], renders[i]);
-  }
   const Eigen::MatrixXd N = FaceNormals(V, F);
   std::vector<OrderedPair> all(2 * pairs.size());
   for (size_t k = 0; k < pairs.size(); ++k) {
     all[2 * k].i = all[2 * k + 1].j = pairs[k].first;
     all[2 * k].j = all[2 * k + 1].i = pairs[k].second;
   }
+  std::map<int, RenderBuffers> held;
+  for (size_t begin = 0, end = 0; begin < pairs.size(); begin = end) {
+    std::set<int> batch;
+    size_t bytes = 0;
+    for (end = begin; end < pairs.size(); ++end) {
+      std::set<int> fresh;
+      for (const int v : {pairs[end].first, pairs[end].second}) {
+        if (batch.count(v) == 0) fresh.insert(v);
+      }
+      size_t more = 0;
+      for (const int v : fresh) more += RenderBytes(views[v]);
+      if (end > begin && bytes + more > max_render_bytes) break;
+      batch.insert(fresh.begin(), fresh.end());
+      bytes += more;
+    }
+    for (auto it = held.begin(); it != held.end();) {
+      it = batch.count(it->first) ? std::next(it) : held.erase(it);
+    }
+    for (const int v : batch) {
+      if (held.count(v)) continue;
+      held[v] = renderer->Render(views[v]);
+      (*footprint)[v] = MedianFootprint(views[v], held[v]);
+    }
 #pragma omp parallel for schedule(dynamic)
-  for (int k = 0; k < static_cast<int>(all.size()); ++k) {
-    const int i = all[k].i, j = all[k].j;
-    all[k].samples = internal::SelectSamples(V, F, N, views[i], renders[i], gray_images[i],
-                                             views[j], renders[j], gray_images[j], max_samples);
+    for (int k = static_cast<int>(2 * begin); k < static_cast<int>(2 * end); ++k) {
+      const int i = all[k].i, j = all[k].j;
+      all[k].samples = internal::SelectSamples(V, F, N, views[i], held.at(i), gray_images[i],
+                                               views[j], held.at(j), gray_images[j], max_samples);
+    }
   }
   std::vector<OrderedPair> ordered;
   for (OrderedPair& pair : all) {
@@ -948,7 +979,8 @@ CameraRefinementSummary RefineCameras(const std::vector<cv::Mat>& gray_images,
   }
   const std::vector<OrderedPair> ordered =
       CollectSamples(gray_images, used_pairs, V, F, renderer, *views,
-                     options.max_samples_per_pair, &summary.footprint);
+                     options.max_samples_per_pair, size_t(options.max_render_mb) << 20,
+                     &summary.footprint);
   summary.sample_seconds = ElapsedSeconds() - start_s;
   summary.num_ordered_pairs = static_cast<int>(ordered.size());
   for (const OrderedPair& pair : ordered) summary.num_samples += pair.samples.size();

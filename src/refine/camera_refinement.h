@@ -109,6 +109,12 @@ struct CameraRefinementOptions {
   // cubic took the worst accuracy90 from 1.245x to 1.228x the exact-camera
   // run and the cameras from 0.314 to 0.302 px (docs/camera_refinement.md).
   std::string interpolation = "cubic";
+  // Renders held at once while the samples are picked, in MB (>= 1): the
+  // pairs are taken in their order, in batches whose views' renders (16
+  // bytes a pixel) fit, so that memory does not grow with the number of
+  // views; a view shared by two batches is rendered twice. mesh_refiner sets
+  // it to half of --Refine.cache_mb.
+  int max_render_mb = 512;
 
   bool Check() const;
 };

@@ -388,6 +388,30 @@ TEST_F(CameraRefinementTest, RecoversPerturbedPoses) {
   EXPECT_LT(after, 0.15);
 }
 
+// Renders held in batches (max_render_mb 1: three of the eight 160 x 120
+// renders of 300 KiB at once, so one or two pairs a batch, and views shared
+// by two batches rendered twice) pick the same samples as all renders at once,
+// and the refinement ends where it does with them.
+TEST_F(CameraRefinementTest, RendersInBatchesPickTheSameSamples) {
+  const Scene& s = *scene_;
+  std::vector<PinholeView> at_once = PerturbPoses(1.0, 11, false), batched = at_once;
+  CameraRefinementOptions options;
+  const CameraRefinementSummary a =
+      RefineCameras(s.images, s.pairs, s.V, s.F, renderer_, {}, options, &at_once);
+  options.max_render_mb = 1;
+  const CameraRefinementSummary b =
+      RefineCameras(s.images, s.pairs, s.V, s.F, renderer_, {}, options, &batched);
+  ASSERT_GT(s.pairs.size(), 4u);
+  EXPECT_EQ(a.num_ordered_pairs, b.num_ordered_pairs);
+  EXPECT_EQ(a.num_samples, b.num_samples);
+  EXPECT_EQ(a.footprint, b.footprint);
+  EXPECT_NEAR(a.initial_cost, b.initial_cost, 1e-9 * a.initial_cost);
+  EXPECT_NEAR(a.final_cost, b.final_cost, 1e-6 * a.final_cost);
+  for (size_t i = 0; i < at_once.size(); ++i) {
+    EXPECT_LT((at_once[i].Center() - batched[i].Center()).norm(), 1e-3 * s.footprint[i]) << i;
+  }
+}
+
 // The mesh fixes the frame: from poses perturbed with no common motion, the
 // mean camera centre and the size of the camera set stay where they were,
 // to within a fraction of a pixel footprint (the size of the set is ~270
@@ -763,6 +787,7 @@ TEST(CameraRefinementOptions, CheckNamesTheField) {
   refused([](CameraRefinementOptions* o) { o->prior_focal_percent = 0; }, "prior_focal_percent",
           "0");
   refused([](CameraRefinementOptions* o) { o->max_iterations = 0; }, "max_iterations", "0");
+  refused([](CameraRefinementOptions* o) { o->max_render_mb = 0; }, "max_render_mb", "0");
 }
 
 TEST_F(CameraRefinementTest, RefusesMismatchedInputs) {

@@ -91,11 +91,20 @@ std::vector<PinholeView> LevelViews(const std::vector<PinholeView>& cameras, int
   return views;
 }
 
-// refine_cameras: refines the level's views against the current mesh, with
-// priors that hold them near `input_cameras` (the SfM cameras at the working
-// resolution, so that repeated refinements do not wander), and carries the
-// result to the working-resolution cameras (a level's intrinsics are the full
-// ones times 2^-level exactly, PyramidLevelView).
+// The bytes of the grey images (CV_32F) of `views`.
+size_t GrayBytes(const std::vector<PinholeView>& views) {
+  size_t bytes = 0;
+  for (const PinholeView& view : views) bytes += size_t(view.width) * view.height * sizeof(float);
+  return bytes;
+}
+
+// refine_cameras: refines the cameras against the current mesh, with priors
+// that hold them near `input_cameras` (the SfM cameras at the working
+// resolution, so that repeated refinements do not wander), at `level` or,
+// where its images exceed `max_bytes`, at a coarser pyramid level
+// (CameraRefinementLevel), and carries the result to the working-resolution
+// `cameras` and the level's `views` (a level's intrinsics are the full ones
+// times 2^-level exactly, PyramidLevelView).
 void RefineCamerasAtLevel(const RefineOptions& options,
                           const std::vector<std::pair<int, int>>& pairs, const Eigen::MatrixXd& V,
                           const Eigen::MatrixXi& F, int level,
@@ -103,31 +112,52 @@ void RefineCamerasAtLevel(const RefineOptions& options,
                           size_t max_bytes, const std::vector<PinholeView>& input_cameras,
                           ImageCache* images, std::vector<PinholeView>* views,
                           std::vector<PinholeView>* cameras, RefineSummary* summary) {
-  size_t bytes = 0;
-  for (const PinholeView& view : *views) bytes += size_t(view.width) * view.height * sizeof(float);
-  if (bytes > max_bytes) {
-    MR_LOG(INFO) << "Cameras not refined at level " << level << ": its images take "
-                 << (bytes >> 20) << " MiB, more than " << (max_bytes >> 20)
-                 << " MiB (half of --Refine.cache_mb)";
+  const int camera_level = CameraRefinementLevel(*views, level, max_bytes);
+  const std::string budget = std::to_string(max_bytes >> 20) + " MiB (half of --Refine.cache_mb)";
+  if (camera_level < 0) {
+    MR_LOG(INFO) << "Cameras not refined at level " << level << ": the images take "
+                 << (GrayBytes(LevelViews(*cameras, level + kMaxCameraLevelsCoarser)) >> 20)
+                 << " MiB even at level " << level + kMaxCameraLevelsCoarser << ", more than "
+                 << budget;
     return;
   }
+  std::vector<PinholeView> camera_views =
+      camera_level == level ? *views : LevelViews(*cameras, camera_level);
+  std::string where;
+  if (camera_level != level) {
+    where = " (at pyramid level " + std::to_string(camera_level) + ": level " +
+            std::to_string(level) + "'s images take " + std::to_string(GrayBytes(*views) >> 20) +
+            " MiB, more than " + budget + ")";
+  }
   std::vector<cv::Mat> gray;
-  for (int i = 0; i < static_cast<int>(views->size()); ++i) gray.push_back(images->Gray(i, level));
+  for (int i = 0; i < static_cast<int>(camera_views.size()); ++i) {
+    gray.push_back(images->Gray(i, camera_level));
+  }
   CameraRefinementOptions camera_options = options.camera_refinement;
   camera_options.mode = options.refine_cameras;
   camera_options.interpolation = options.pair.interpolation;
-  const std::vector<PinholeView> prior = LevelViews(input_cameras, level);
-  const CameraRefinementSummary refined =
-      RefineCameras(gray, pairs, V, F, renderer, camera_of_view, camera_options, views, &prior);
-  MR_LOG(INFO) << "Level " << level << " cameras: " << refined.BriefReport();
+  camera_options.max_render_mb = std::max<int>(1, static_cast<int>(max_bytes >> 20));
+  // The options in pixel footprints keep their size in the surface level's
+  // pixels (the user's), which are 2^-(camera_level - level) of a coarser
+  // level's.
+  const double coarser = std::ldexp(1.0, camera_level - level);
+  camera_options.prior_center_px /= coarser;
+  camera_options.surface_sigma_px /= coarser;
+  camera_options.datum_sigma_px /= coarser;
+  const std::vector<PinholeView> prior = LevelViews(input_cameras, camera_level);
+  const CameraRefinementSummary refined = RefineCameras(
+      gray, pairs, V, F, renderer, camera_of_view, camera_options, &camera_views, &prior);
+  MR_LOG(INFO) << "Level " << level << " cameras" << where << ": " << refined.BriefReport();
   MR_LOG(VERBOSE) << refined.FullReport();
-  summary->camera_reports.push_back("level " + std::to_string(level) + ": " + refined.BriefReport());
-  const double scale = std::ldexp(1.0, level);
-  for (size_t i = 0; i < views->size(); ++i) {
-    PinholeView full = (*views)[i].Scaled(scale);
+  summary->camera_reports.push_back("level " + std::to_string(level) + where + ": " +
+                                    refined.BriefReport());
+  const double scale = std::ldexp(1.0, camera_level);
+  for (size_t i = 0; i < camera_views.size(); ++i) {
+    PinholeView full = camera_views[i].Scaled(scale);
     full.width = (*cameras)[i].width;  // the level's sizes were rounded up
     full.height = (*cameras)[i].height;
     (*cameras)[i] = full;
+    (*views)[i] = camera_level == level ? camera_views[i] : PyramidLevelView(full, level);
   }
 }
 
@@ -278,6 +308,15 @@ std::vector<int> CameraRoundIterations(int iterations, int rounds) {
     at.push_back(k * (k + 1) / 2);
   }
   return at;
+}
+
+int CameraRefinementLevel(const std::vector<PinholeView>& level_views, int level,
+                          size_t max_bytes) {
+  MR_CHECK_GE(level, 0);
+  for (int k = 0; k <= kMaxCameraLevelsCoarser; ++k) {
+    if (GrayBytes(LevelViews(level_views, k)) <= max_bytes) return level + k;
+  }
+  return -1;
 }
 
 int FirstAveragedIteration(int iterations, int average_last,
@@ -711,7 +750,7 @@ bool RefineOptions::Check() const {
   if (!(light_ambient >= 0 && light_ambient <= 1)) {
     fail("light_ambient", std::to_string(light_ambient), "0 <= light_ambient <= 1");
   }
-  if (cache_mb < 64) fail("cache_mb", std::to_string(cache_mb), "cache_mb >= 64");
+  if (cache_mb < 1) fail("cache_mb", std::to_string(cache_mb), "cache_mb >= 1");
   background_mask.Check();
   mask_outline.Check();
   view_selection.Check();

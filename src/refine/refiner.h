@@ -190,9 +190,10 @@ struct RefineOptions {
   // the finest level (camera_rounds times, CameraRoundIterations;
   // camera_refinement.h), with priors centred on the input cameras: "none",
   // "poses" (rotation and centre of every view) or "poses_intrinsics" (also
-  // fx, fy, cx, cy, shared by the views of one camera). The level's images
-  // of all views are held at once for it; a level whose images would take
-  // more than half of cache_mb is not refined (logged). Default "none": on
+  // fx, fy, cx, cy, shared by the views of one camera). The grey images of
+  // all views are held at once for it, at the finest level whose images fit
+  // in half of cache_mb (CameraRefinementLevel: up to two levels coarser
+  // than the surface's; logged, and not refined if none fits). Default "none": on
   // the corpus it helps where the cameras are 0.5-2 px off, but with exact
   // cameras it costs 0-4 % of accuracy90 and on COLMAP's own cameras of
   // templeSparseRing it lowers the held-out photo-consistency a little
@@ -268,7 +269,8 @@ struct RefineOptions {
   // their vertices back (UndoSelfIntersections), so that thin parts cannot
   // fold through each other. Off: only the final repair runs.
   bool prevent_self_intersections = true;
-  // Memory budget for cached images and renders, in MB (>= 64).
+  // Memory budget for cached images and renders, in MB (>= 1). Half of it
+  // also bounds the images camera refinement holds at once.
   int cache_mb = 1024;
 
   ViewSelectionOptions view_selection;
@@ -326,6 +328,20 @@ struct RefineIteration {
 // Rounds that would fall at or after the last iteration are not made, so the
 // list may be shorter than `rounds`.
 std::vector<int> CameraRoundIterations(int iterations, int rounds);
+
+// How many pyramid levels coarser than the surface's the cameras may be
+// refined at when the surface's level does not fit the memory budget: a
+// quarter of its resolution, where a pose error of 1 px is still a quarter
+// of a pixel.
+constexpr int kMaxCameraLevelsCoarser = 2;
+
+// The pyramid level at which the cameras are refined while the surface is
+// refined at `level`, with `level_views` the views at `level`: `level` itself
+// if the grey images of all views (4 bytes a pixel) fit in `max_bytes`, else
+// the first coarser level whose images do, at most kMaxCameraLevelsCoarser
+// levels coarser; -1 if none does. Camera refinement holds all of them at once.
+int CameraRefinementLevel(const std::vector<PinholeView>& level_views, int level,
+                          size_t max_bytes);
 
 // Iterations after a camera round in which the surface follows the new
 // cameras before average_last_iterates may average its iterates.

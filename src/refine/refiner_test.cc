@@ -207,6 +207,29 @@ TEST(CameraRoundIterations, EachRoundOneIterationLaterThanTheGapBefore) {
   EXPECT_EQ(CameraRoundIterations(1, 3), Rounds());
 }
 
+// The cameras are refined at the surface's level when all its grey images fit
+// the budget, else at the first coarser level whose images do (sizes halved
+// rounding up, as the pyramid's), at most kMaxCameraLevelsCoarser coarser.
+TEST(CameraRefinementLevel, TheFinestLevelWhoseImagesFit) {
+  PinholeView view;
+  view.width = 1281;  // odd: the level sizes round up, 641 x 480 and 321 x 240
+  view.height = 960;
+  const std::vector<PinholeView> views(10, view);
+  const size_t level0 = 10 * 1281 * 960 * 4, level1 = 10 * 641 * 480 * 4,
+               level2 = 10 * 321 * 240 * 4;
+  EXPECT_EQ(CameraRefinementLevel(views, 0, level0), 0);
+  EXPECT_EQ(CameraRefinementLevel(views, 0, level0 - 1), 1);
+  EXPECT_EQ(CameraRefinementLevel(views, 0, level1), 1);
+  EXPECT_EQ(CameraRefinementLevel(views, 0, level1 - 1), 2);
+  EXPECT_EQ(CameraRefinementLevel(views, 0, level2), 2);
+  EXPECT_EQ(CameraRefinementLevel(views, 0, level2 - 1), -1);
+  // Given the views of level 1 (here the same sizes), the levels count from 1.
+  EXPECT_EQ(CameraRefinementLevel(views, 1, level0), 1);
+  EXPECT_EQ(CameraRefinementLevel(views, 1, level0 - 1), 2);
+  EXPECT_EQ(CameraRefinementLevel(views, 1, level2 - 1), -1);
+  EXPECT_EQ(CameraRefinementLevel({}, 0, 0), 0);
+}
+
 // The defaults' 14 iterations average the last 8; after a camera round the
 // surface first follows the new cameras for kCameraSettlingIterations (4).
 TEST(FirstAveragedIteration, LastIteratesAfterTheSurfaceSettled) {
@@ -776,6 +799,23 @@ TEST_F(RefinerTest, CameraRefinementUndoesPoseError) {
   std::printf("one camera round: pose error %.3f -> %.3f px, accuracy90 %.4f\n", error_before,
               error_one, Evaluate(once.V, once.F, V, F).accuracy90);
   EXPECT_LT(error_one, 0.4 * error_before) << one.camera_reports[0];
+
+  // A memory budget smaller than the views' images (8 of 160 x 120, 600 KiB,
+  // against half of a 1 MiB cache): the cameras are refined at pyramid level
+  // 1 (80 x 60) while the surface is at level 0, and carried back to it.
+  RefineOptions small_cache = options;
+  small_cache.cache_mb = 1;
+  TriangleMesh coarse_cameras;
+  coarse_cameras.V = V;
+  coarse_cameras.F = F;
+  const RefineSummary coarser = RefineMesh(wrong, small_cache, &coarse_cameras, renderer_);
+  ASSERT_EQ(coarser.camera_reports.size(), 1u) << coarser.FullReport();
+  EXPECT_EQ(coarser.camera_reports[0].rfind("level 0 (at pyramid level 1: ", 0), 0u)
+      << coarser.camera_reports[0];
+  const double error_coarser = ReprojectionRmsPx(true_views, coarser.cameras, V);
+  std::printf("cameras at level 1: pose error %.3f -> %.3f px, accuracy90 %.4f\n", error_before,
+              error_coarser, Evaluate(coarse_cameras.V, coarse_cameras.F, V, F).accuracy90);
+  EXPECT_LT(error_coarser, 0.4 * error_before) << coarser.camera_reports[0];
 
   // Two levels: still only within the finest one, never at the coarse
   // level's surface.
