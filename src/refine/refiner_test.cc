@@ -784,6 +784,13 @@ TEST_F(RefinerTest, CameraRefinementUndoesPoseError) {
   EXPECT_LT(b.accuracy90, a.accuracy90);
   EXPECT_GT(with.final_similarity, without.final_similarity);
 
+  // The true mesh refined on the wrong cameras with `o`, into `mesh`.
+  const auto refine_truth = [&](const RefineOptions& o, TriangleMesh* mesh) {
+    mesh->V = V;
+    mesh->F = F;
+    return RefineMesh(wrong, o, mesh, renderer_);
+  };
+
   // camera_rounds 1: a single refinement, after the first iteration. It
   // undoes as much here (0.230 px against the default's 0.241; its second
   // round starts from where the first left the cameras, its priors still
@@ -791,9 +798,7 @@ TEST_F(RefinerTest, CameraRefinementUndoesPoseError) {
   // later rounds (docs/camera_refinement.md).
   options.camera_rounds = 1;
   TriangleMesh once;
-  once.V = V;
-  once.F = F;
-  const RefineSummary one = RefineMesh(wrong, options, &once, renderer_);
+  const RefineSummary one = refine_truth(options, &once);
   ASSERT_EQ(one.camera_reports.size(), 1u) << one.FullReport();
   const double error_one = ReprojectionRmsPx(true_views, one.cameras, V);
   std::printf("one camera round: pose error %.3f -> %.3f px, accuracy90 %.4f\n", error_before,
@@ -806,9 +811,7 @@ TEST_F(RefinerTest, CameraRefinementUndoesPoseError) {
   RefineOptions small_cache = options;
   small_cache.cache_mb = 1;
   TriangleMesh coarse_cameras;
-  coarse_cameras.V = V;
-  coarse_cameras.F = F;
-  const RefineSummary coarser = RefineMesh(wrong, small_cache, &coarse_cameras, renderer_);
+  const RefineSummary coarser = refine_truth(small_cache, &coarse_cameras);
   ASSERT_EQ(coarser.camera_reports.size(), 1u) << coarser.FullReport();
   EXPECT_EQ(coarser.camera_reports[0].rfind("level 0 (at pyramid level 1: ", 0), 0u)
       << coarser.camera_reports[0];
@@ -821,9 +824,7 @@ TEST_F(RefinerTest, CameraRefinementUndoesPoseError) {
   // level's surface.
   options.num_levels = 2;
   TriangleMesh levels;
-  levels.V = V;
-  levels.F = F;
-  const RefineSummary coarse = RefineMesh(wrong, options, &levels, renderer_);
+  const RefineSummary coarse = refine_truth(options, &levels);
   ASSERT_FALSE(coarse.iterations.empty());
   EXPECT_EQ(coarse.iterations.front().level, 1) << coarse.FullReport();
   ASSERT_EQ(coarse.camera_reports.size(), 1u) << coarse.FullReport();
