@@ -113,11 +113,16 @@ void RefineCamerasAtLevel(const RefineOptions& options,
                           ImageCache* images, std::vector<PinholeView>* views,
                           std::vector<PinholeView>* cameras, RefineSummary* summary) {
   const int camera_level = CameraRefinementLevel(*views, level, max_bytes);
-  const std::string budget = std::to_string(max_bytes >> 20) + " MiB (half of --Refine.cache_mb)";
+  const auto mib = [](size_t bytes) {
+    std::ostringstream out;
+    out << std::setprecision(3) << bytes / 1048576.0 << " MiB";
+    return out.str();
+  };
+  const std::string budget = mib(max_bytes) + " (half of --Refine.cache_mb)";
   if (camera_level < 0) {
     MR_LOG(INFO) << "Cameras not refined at level " << level << ": the images take "
-                 << (GrayBytes(LevelViews(*cameras, level + kMaxCameraLevelsCoarser)) >> 20)
-                 << " MiB even at level " << level + kMaxCameraLevelsCoarser << ", more than "
+                 << mib(GrayBytes(LevelViews(*cameras, level + kMaxCameraLevelsCoarser)))
+                 << " even at level " << level + kMaxCameraLevelsCoarser << ", more than "
                  << budget;
     return;
   }
@@ -126,8 +131,8 @@ void RefineCamerasAtLevel(const RefineOptions& options,
   std::string where;
   if (camera_level != level) {
     where = " (at pyramid level " + std::to_string(camera_level) + ": level " +
-            std::to_string(level) + "'s images take " + std::to_string(GrayBytes(*views) >> 20) +
-            " MiB, more than " + budget + ")";
+            std::to_string(level) + "'s images take " + mib(GrayBytes(*views)) + ", more than " +
+            budget + ")";
   }
   std::vector<cv::Mat> gray;
   for (int i = 0; i < static_cast<int>(camera_views.size()); ++i) {

@@ -192,8 +192,8 @@ struct RefineOptions {
   // "poses" (rotation and centre of every view) or "poses_intrinsics" (also
   // fx, fy, cx, cy, shared by the views of one camera). The grey images of
   // all views are held at once for it, at the finest level whose images fit
-  // in half of cache_mb (CameraRefinementLevel: up to two levels coarser
-  // than the surface's; logged, and not refined if none fits). Default "none": on
+  // in half of cache_mb (CameraRefinementLevel: the surface's or the next
+  // coarser; logged, and not refined if neither fits). Default "none": on
   // the corpus it helps where the cameras are 0.5-2 px off, but with exact
   // cameras it costs 0-4 % of accuracy90 and on COLMAP's own cameras of
   // templeSparseRing it lowers the held-out photo-consistency a little
@@ -330,10 +330,12 @@ struct RefineIteration {
 std::vector<int> CameraRoundIterations(int iterations, int rounds);
 
 // How many pyramid levels coarser than the surface's the cameras may be
-// refined at when the surface's level does not fit the memory budget: a
-// quarter of its resolution, where a pose error of 1 px is still a quarter
-// of a pixel.
-constexpr int kMaxCameraLevelsCoarser = 2;
+// refined at when the surface's level does not fit the memory budget. At 1 px
+// of pose error, one level coarser brought three cases to within 2-6 % of
+// the rounds at the surface's level; two coarser made homer-color-small's
+// accuracy90 worse than no camera refinement (1,272 samples a round;
+// docs/camera_refinement.md, "Thirty-seventh session").
+constexpr int kMaxCameraLevelsCoarser = 1;
 
 // The pyramid level at which the cameras are refined while the surface is
 // refined at `level`, with `level_views` the views at `level`: `level` itself

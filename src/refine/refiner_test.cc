@@ -208,25 +208,23 @@ TEST(CameraRoundIterations, EachRoundOneIterationLaterThanTheGapBefore) {
 }
 
 // The cameras are refined at the surface's level when all its grey images fit
-// the budget, else at the first coarser level whose images do (sizes halved
-// rounding up, as the pyramid's), at most kMaxCameraLevelsCoarser coarser.
+// the budget, else at the next coarser level if its images do (sizes halved
+// rounding up, as the pyramid's; kMaxCameraLevelsCoarser is 1), else not.
 TEST(CameraRefinementLevel, TheFinestLevelWhoseImagesFit) {
+  ASSERT_EQ(kMaxCameraLevelsCoarser, 1);
   PinholeView view;
-  view.width = 1281;  // odd: the level sizes round up, 641 x 480 and 321 x 240
+  view.width = 1281;  // odd: level 1 rounds up to 641 x 480
   view.height = 960;
   const std::vector<PinholeView> views(10, view);
-  const size_t level0 = 10 * 1281 * 960 * 4, level1 = 10 * 641 * 480 * 4,
-               level2 = 10 * 321 * 240 * 4;
+  const size_t level0 = 10 * 1281 * 960 * 4, level1 = 10 * 641 * 480 * 4;
   EXPECT_EQ(CameraRefinementLevel(views, 0, level0), 0);
   EXPECT_EQ(CameraRefinementLevel(views, 0, level0 - 1), 1);
   EXPECT_EQ(CameraRefinementLevel(views, 0, level1), 1);
-  EXPECT_EQ(CameraRefinementLevel(views, 0, level1 - 1), 2);
-  EXPECT_EQ(CameraRefinementLevel(views, 0, level2), 2);
-  EXPECT_EQ(CameraRefinementLevel(views, 0, level2 - 1), -1);
+  EXPECT_EQ(CameraRefinementLevel(views, 0, level1 - 1), -1);
   // Given the views of level 1 (here the same sizes), the levels count from 1.
   EXPECT_EQ(CameraRefinementLevel(views, 1, level0), 1);
   EXPECT_EQ(CameraRefinementLevel(views, 1, level0 - 1), 2);
-  EXPECT_EQ(CameraRefinementLevel(views, 1, level2 - 1), -1);
+  EXPECT_EQ(CameraRefinementLevel(views, 1, level1 - 1), -1);
   EXPECT_EQ(CameraRefinementLevel({}, 0, 0), 0);
 }
 
