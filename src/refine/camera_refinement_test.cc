@@ -736,32 +736,25 @@ TEST(CameraSetDatum, MeasuresTheSimilarityOfTheSet) {
 // lowered the cost by less than the threshold, and not before: not at a
 // rejection after a large decrease, nor at a small decrease itself.
 TEST(StopOnRejectedStep, EndsAtARejectionAfterASmallDecrease) {
-  internal::StopOnRejectedStep stop(1e-2);
-  auto step = [&](int iteration, bool successful, double cost, double cost_change) {
+  auto step = [](internal::StopOnRejectedStep* stop, int iteration, bool successful, double cost,
+                 double cost_change) {
     ceres::IterationSummary s;
     s.iteration = iteration;
     s.step_is_successful = successful;
     s.cost = cost;
     s.cost_change = cost_change;
-    return stop(s);
+    return (*stop)(s);
   };
-  EXPECT_EQ(step(0, false, 100.0, 0.0), ceres::SOLVER_CONTINUE);   // the start
-  EXPECT_EQ(step(1, true, 50.0, 50.0), ceres::SOLVER_CONTINUE);    // -50 %
-  EXPECT_EQ(step(2, false, 50.0, -1.0), ceres::SOLVER_CONTINUE);   // rejected after -50 %
-  EXPECT_EQ(step(3, true, 49.8, 0.2), ceres::SOLVER_CONTINUE);     // -0.4 %
-  EXPECT_EQ(step(4, false, 49.8, -0.5), ceres::SOLVER_TERMINATE_SUCCESSFULLY);
+  internal::StopOnRejectedStep stop(1e-2);
+  EXPECT_EQ(step(&stop, 0, false, 100.0, 0.0), ceres::SOLVER_CONTINUE);  // the start
+  EXPECT_EQ(step(&stop, 1, true, 50.0, 50.0), ceres::SOLVER_CONTINUE);   // -50 %
+  EXPECT_EQ(step(&stop, 2, false, 50.0, -1.0), ceres::SOLVER_CONTINUE);  // rejected after -50 %
+  EXPECT_EQ(step(&stop, 3, true, 49.8, 0.2), ceres::SOLVER_CONTINUE);    // -0.4 %
+  EXPECT_EQ(step(&stop, 4, false, 49.8, -0.5), ceres::SOLVER_TERMINATE_SUCCESSFULLY);
   // A threshold below the last decrease keeps going.
   internal::StopOnRejectedStep strict(1e-3);
-  ceres::IterationSummary s;
-  s.iteration = 1;
-  s.step_is_successful = true;
-  s.cost = 49.8;
-  s.cost_change = 0.2;
-  EXPECT_EQ(strict(s), ceres::SOLVER_CONTINUE);
-  s.iteration = 2;
-  s.step_is_successful = false;
-  s.cost_change = -0.5;
-  EXPECT_EQ(strict(s), ceres::SOLVER_CONTINUE);
+  EXPECT_EQ(step(&strict, 1, true, 49.8, 0.2), ceres::SOLVER_CONTINUE);
+  EXPECT_EQ(step(&strict, 2, false, 49.8, -0.5), ceres::SOLVER_CONTINUE);
 }
 
 TEST(CameraRefinementOptions, DefaultsAreValid) { EXPECT_TRUE(CameraRefinementOptions().Check()); }
