@@ -687,12 +687,6 @@ struct OrderedPair {
   std::vector<internal::PhotometricSample> samples;
 };
 
-// Bytes of a render of `view` (face id, depth and barycentric coordinates).
-size_t RenderBytes(const PinholeView& view) {
-  return size_t(view.width) * view.height *
-         (sizeof(int32_t) + sizeof(float) + 2 * sizeof(float));
-}
-
 // Renders the views in `pairs` through the mesh (footprints into
 // `footprint`) and picks the samples of both orders of every pair; ordered
 // pairs without samples are left out. The pairs are taken in their order, in
@@ -722,7 +716,7 @@ std::vector<OrderedPair> CollectSamples(const std::vector<cv::Mat>& gray_images,
         if (batch.count(v) == 0) fresh.insert(v);
       }
       size_t more = 0;
-      for (const int v : fresh) more += RenderBytes(views[v]);
+      for (const int v : fresh) more += RenderBuffers::Bytes(views[v].width, views[v].height);
       if (end > begin && bytes + more > max_render_bytes) break;
       batch.insert(fresh.begin(), fresh.end());
       bytes += more;

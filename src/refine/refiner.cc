@@ -45,12 +45,12 @@ class RenderCache {
       }
     }
     auto render = std::make_shared<const RenderBuffers>(renderer_->Render(views_[i]));
-    const size_t bytes = static_cast<size_t>(render->width) * render->height * 16;
+    const size_t bytes = RenderBuffers::Bytes(render->width, render->height);
     entries_.emplace_front(i, render);
     bytes_ += bytes;
     while (bytes_ > max_bytes_ && entries_.size() > 1) {
       const auto& last = entries_.back().second;
-      bytes_ -= static_cast<size_t>(last->width) * last->height * 16;
+      bytes_ -= RenderBuffers::Bytes(last->width, last->height);
       entries_.pop_back();
     }
     ++num_renders_;
@@ -126,8 +126,7 @@ void RefineCamerasAtLevel(const RefineOptions& options,
                  << budget;
     return;
   }
-  std::vector<PinholeView> camera_views =
-      camera_level == level ? *views : LevelViews(*cameras, camera_level);
+  std::vector<PinholeView> camera_views = LevelViews(*cameras, camera_level);
   std::string where;
   if (camera_level != level) {
     where = " (at pyramid level " + std::to_string(camera_level) + ": level " +
@@ -162,7 +161,9 @@ void RefineCamerasAtLevel(const RefineOptions& options,
     full.width = (*cameras)[i].width;  // the level's sizes were rounded up
     full.height = (*cameras)[i].height;
     (*cameras)[i] = full;
-    (*views)[i] = camera_level == level ? camera_views[i] : PyramidLevelView(full, level);
+    // At camera_level == level this is camera_views[i] again: the intrinsics
+    // scale by powers of 2, exactly.
+    (*views)[i] = PyramidLevelView(full, level);
   }
 }
 

@@ -56,6 +56,12 @@ struct RenderBuffers {
   // is (1 - u - v) * V(F(f,0)) + u * V(F(f,1)) + v * V(F(f,2)). 2 per pixel.
   std::vector<float> bary;
 
+  // Bytes of the buffers of a width x height render: a face id, a depth and
+  // two barycentric coordinates per pixel.
+  static size_t Bytes(int width, int height) {
+    return static_cast<size_t>(width) * height * (sizeof(int32_t) + 3 * sizeof(float));
+  }
+
   int FaceAt(int row, int col) const { return face_id[static_cast<size_t>(row) * width + col]; }
   float DepthAt(int row, int col) const { return depth[static_cast<size_t>(row) * width + col]; }
 };
