@@ -31,6 +31,15 @@ void KeepFreedBuffersInProcess() {
 
 }  // namespace
 
+size_t HeapBytesInUse() {
+#if defined(__GLIBC__)
+  const struct mallinfo2 info = mallinfo2();
+  return info.uordblks + info.hblkhd;
+#else
+  return 0;
+#endif
+}
+
 int RunProgram(const std::function<int()>& body) {
   KeepFreedBuffersInProcess();
   InstallInterruptHandlers();

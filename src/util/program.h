@@ -13,10 +13,17 @@
 // also sets glibc to reuse freed multi-MB buffers instead of returning them
 // to the kernel at once (see program.cc).
 
+#include <cstddef>
 #include <functional>
 
 namespace mr {
 
 int RunProgram(const std::function<int()>& body);
+
+// Bytes of heap in use, as glibc counts them (mallinfo2: allocated chunks
+// plus mmapped blocks), or 0 where the C library does not say. The
+// difference between two calls is what was allocated in between and not
+// freed.
+size_t HeapBytesInUse();
 
 }  // namespace mr

@@ -9,6 +9,7 @@
 #include <filesystem>
 #include <fstream>
 #include <limits>
+#include <memory>
 #include <random>
 #include <vector>
 
@@ -19,6 +20,7 @@
 #include "util/statistics.h"
 #include "util/testing.h"
 #include "util/options.h"
+#include "util/program.h"
 
 namespace mr {
 namespace {
@@ -167,6 +169,25 @@ TEST(InterruptHandlers, RemoveRegisteredTemporariesAndExit) {
     EXPECT_TRUE(ExistsFile(kept));
     std::filesystem::remove(kept);
   }
+}
+
+// What is allocated and kept shows in the heap in use, and leaves it when
+// freed (glibc's count; AddressSanitizer's allocator is not in it).
+TEST(HeapBytesInUse, FollowsAnAllocation) {
+#if defined(__SANITIZE_ADDRESS__)
+  GTEST_SKIP() << "AddressSanitizer's heap is not glibc's";
+#else
+  const size_t before = HeapBytesInUse();
+  ASSERT_GT(before, 0u);
+  constexpr size_t kBytes = 32 << 20;
+  auto buffer = std::make_unique<char[]>(kBytes);
+  std::fill(buffer.get(), buffer.get() + kBytes, 1);
+  const size_t held = HeapBytesInUse();
+  EXPECT_GE(held, before + kBytes);
+  EXPECT_LT(held, before + kBytes + (1 << 20));
+  buffer.reset();
+  EXPECT_LT(HeapBytesInUse(), before + (1 << 20));
+#endif
 }
 
 TEST(ReadNameList, SkipsBlankLinesAndComments) {
