@@ -21,6 +21,7 @@
 #include "render/renderer.h"
 #include "util/error.h"
 #include "util/logging.h"
+#include "util/program.h"
 #include "util/statistics.h"
 
 namespace mr {
@@ -142,7 +143,7 @@ class PhotometricCost : public ceres::CostFunction {
   PhotometricCost(const PhotometricSample& sample, const cv::Mat& image_j, bool shared_intrinsics,
                   bool free_surface, bool cubic)
       : sample_(sample),
-        image_j_(image_j),
+        image_j_(&image_j),
         shared_(shared_intrinsics),
         free_(free_surface),
         cubic_(cubic) {
@@ -157,7 +158,7 @@ class PhotometricCost : public ceres::CostFunction {
       return J == nullptr || J[k] == nullptr ? nullptr : J[k] + offset;
     };
     if (!shared_) {
-      return EvaluatePhotometric(sample_, image_j_, cubic_, p[0], p[0] + 9, p[1], p[2], p[2] + 9,
+      return EvaluatePhotometric(sample_, *image_j_, cubic_, p[0], p[0] + 9, p[1], p[2], p[2] + 9,
                                  p[3],
                                  p[4], free_ ? p[5] : nullptr, residual, jac(0, 0), jac(0, 9),
                                  jac(1, 0), jac(2, 0), jac(2, 9), jac(3, 0), jac(4, 0),
@@ -165,7 +166,7 @@ class PhotometricCost : public ceres::CostFunction {
     }
     double J_Ki[4], J_Kj[4];
     const bool want_k = jac(2, 0) != nullptr;
-    if (!EvaluatePhotometric(sample_, image_j_, cubic_, p[0], p[0] + 9, p[2], p[1], p[1] + 9, p[2],
+    if (!EvaluatePhotometric(sample_, *image_j_, cubic_, p[0], p[0] + 9, p[2], p[1], p[1] + 9, p[2],
                              p[3],
                              free_ ? p[4] : nullptr, residual, jac(0, 0), jac(0, 9),
                              want_k ? J_Ki : nullptr, jac(1, 0), jac(1, 9),
@@ -180,7 +181,7 @@ class PhotometricCost : public ceres::CostFunction {
 
  private:
   PhotometricSample sample_;
-  cv::Mat image_j_;
+  const cv::Mat* image_j_;  // by address: a cv::Mat header takes 96 bytes
   bool shared_;
   bool free_;
   bool cubic_;
@@ -560,6 +561,10 @@ bool CameraRefinementOptions::Check() const {
     MR_THROW_INPUT << "CameraRefinementOptions::max_render_mb = " << max_render_mb
                    << ". Violated constraint: max_render_mb >= 1";
   }
+  if (max_problem_mb < 1) {
+    MR_THROW_INPUT << "CameraRefinementOptions::max_problem_mb = " << max_problem_mb
+                   << ". Violated constraint: max_problem_mb >= 1";
+  }
   return true;
 }
 
@@ -923,6 +928,17 @@ void WriteBack(const CameraParameters& p, const std::vector<char>& refined, bool
   }
 }
 
+// The most heap in use at the end of any Ceres iteration (HeapBytesInUse).
+class HeapPeak : public ceres::IterationCallback {
+ public:
+  explicit HeapPeak(size_t bytes) : peak(bytes) {}
+  ceres::CallbackReturnType operator()(const ceres::IterationSummary&) override {
+    peak = std::max(peak, HeapBytesInUse());
+    return ceres::SOLVER_CONTINUE;
+  }
+  size_t peak;
+};
+
 }  // namespace
 
 // The relative cost decrease of the last accepted step below which a
@@ -971,10 +987,14 @@ CameraRefinementSummary RefineCameras(const std::vector<cv::Mat>& gray_images,
   for (const auto& [i, j] : pairs) {
     if (!(fixed[i] && fixed[j])) used_pairs.emplace_back(i, j);
   }
+  const size_t heap_start = HeapBytesInUse();
+  summary.samples_per_pair = SamplesPerPair(options, 2 * used_pairs.size(), F.rows());
+  if (summary.samples_per_pair < options.max_samples_per_pair) {
+    summary.cut_to_fit_mb = options.max_problem_mb;
+  }
   const std::vector<OrderedPair> ordered =
-      CollectSamples(gray_images, used_pairs, V, F, renderer, *views,
-                     options.max_samples_per_pair, size_t(options.max_render_mb) << 20,
-                     &summary.footprint);
+      CollectSamples(gray_images, used_pairs, V, F, renderer, *views, summary.samples_per_pair,
+                     size_t(options.max_render_mb) << 20, &summary.footprint);
   summary.sample_seconds = ElapsedSeconds() - start_s;
   summary.num_ordered_pairs = static_cast<int>(ordered.size());
   for (const OrderedPair& pair : ordered) summary.num_samples += pair.samples.size();
@@ -1015,8 +1035,13 @@ CameraRefinementSummary RefineCameras(const std::vector<cv::Mat>& gray_images,
   // two rounds.
   internal::StopOnRejectedStep stop(kStopRejectedBelow);
   solver.callbacks.push_back(&stop);
+  HeapPeak heap(HeapBytesInUse());
+  solver.callbacks.push_back(&heap);
   ceres::Solver::Summary ceres_summary;
   ceres::Solve(solver, &problem, &ceres_summary);
+  if (heap_start > 0 && heap.peak > heap_start) {
+    summary.heap_mb = static_cast<double>(heap.peak - heap_start) / (1 << 20);
+  }
 
   summary.initial_cost = ceres_summary.initial_cost;
   summary.final_cost = ceres_summary.final_cost;
@@ -1072,10 +1097,25 @@ CameraRefinementSummary RefineCameras(const std::vector<cv::Mat>& gray_images,
   return summary;
 }
 
+int SamplesPerPair(const CameraRefinementOptions& options, size_t num_ordered_pairs,
+                   size_t num_faces) {
+  const size_t budget = size_t(options.max_problem_mb) << 20;
+  const size_t mesh = num_faces * kProblemBytesPerFace;
+  const size_t samples = budget > mesh ? (budget - mesh) / kProblemBytesPerSample : 0;
+  const size_t fit = samples / std::max<size_t>(1, num_ordered_pairs);
+  return static_cast<int>(
+      std::clamp<size_t>(fit, 1, static_cast<size_t>(options.max_samples_per_pair)));
+}
+
 std::string CameraRefinementSummary::BriefReport() const {
   std::ostringstream out;
   out << "Camera refinement (" << mode << "): " << num_views_refined << " views, "
       << num_ordered_pairs << " ordered pairs, " << num_samples << " samples";
+  if (heap_mb > 0) out << " in " << std::setprecision(3) << heap_mb << " MB";
+  if (cut_to_fit_mb > 0) {
+    out << " (at most " << samples_per_pair << " a pair: more would not fit max_problem_mb, "
+        << cut_to_fit_mb << " MB)";
+  }
   if (num_faces > 0) {
     out << ", " << num_faces << " face planes free (moved " << std::setprecision(3)
         << median_surface_offset_px << " px footprints median, " << max_surface_offset_px

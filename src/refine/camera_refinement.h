@@ -115,15 +115,54 @@ struct CameraRefinementOptions {
   // views; a view shared by two batches is rendered twice. mesh_refiner sets
   // it to half of --Refine.cache_mb.
   int max_render_mb = 512;
+  // Memory for the least-squares problem, in MB (>= 1). Ceres holds about
+  // kProblemBytesPerSample per photometric sample, so that
+  // max_samples_per_pair samples for every ordered pair grow with the number
+  // of views (436 views with 4.3 ordered pairs each: 5.6M samples, 6 GiB).
+  // Where they would take more than this, every pair gets fewer
+  // (SamplesPerPair). 1024 holds 892,000 samples on a mesh of 750,000
+  // faces: 60 views of 1280x960 in 258 ordered pairs (774,000) are not cut;
+  // at 435 a pair they still met the targets of docs/camera_refinement.md.
+  int max_problem_mb = 1024;
 
   bool Check() const;
 };
+
+// The memory a camera refinement holds, for CameraRefinementOptions::
+// max_problem_mb: kProblemBytesPerSample per photometric sample (the samples,
+// the residual blocks with their cost functions, the solve's Jacobian and
+// Schur elimination) and kProblemBytesPerFace per face of the mesh (its
+// plane offsets and its copy in the renderer). Fitted to the growth of the
+// in-use heap from before the samples were picked to the solve's peak in ten
+// rounds (the README's example: 162,000 samples on 160,000 faces; 60 views
+// of 1280x960: 112,000-774,000 samples on 747,000 faces), which it exceeds
+// in every one; a sample took 1,097-1,467 bytes of it, more where there were
+// fewer samples to share the mesh's part. Measured before the cost functions
+// kept their image by address instead of a 96-byte cv::Mat header (the test
+// scene's 48,000 samples: 40.8 -> 36.4 MB).
+constexpr size_t kProblemBytesPerSample = 1150;
+constexpr size_t kProblemBytesPerFace = 64;
+
+// The most samples each of `num_ordered_pairs` ordered pairs gets:
+// options.max_samples_per_pair, or fewer (at least 1) where that many for
+// every pair, with a mesh of `num_faces` faces, would take more than
+// options.max_problem_mb.
+int SamplesPerPair(const CameraRefinementOptions& options, size_t num_ordered_pairs,
+                   size_t num_faces);
 
 struct CameraRefinementSummary {
   std::string mode;
   int num_views_refined = 0;  // views in at least one pair with samples
   int num_ordered_pairs = 0;  // ordered pairs with samples
   long num_samples = 0;       // photometric residuals
+  // The most samples an ordered pair could get (SamplesPerPair), and
+  // max_problem_mb where it cut that below max_samples_per_pair (else 0).
+  int samples_per_pair = 0;
+  int cut_to_fit_mb = 0;
+  // The most heap the refinement held above what was in use at its start,
+  // at the end of any Ceres iteration: the samples, the problem and the
+  // solver's (HeapBytesInUse; 0 where the C library does not say).
+  double heap_mb = 0;
   // Faces whose plane offset was free (surface_sigma_px > 0), and the median
   // and largest |δ_f| at the end, in pixel footprints.
   int num_faces = 0;
@@ -231,8 +270,9 @@ std::vector<PhotometricSample> SelectSamples(const Eigen::MatrixXd& V, const Eig
 //   shared_intrinsics = true:  pose_i (12), pose_j (12), K (4), (a, b)
 // and with free_surface a last block (1): the offset δ of the sample's face
 // plane, n·X = plane_offset + δ.
-// `image_j` (CV_32F) must outlive the cost function (its data is shared); it
-// is read by cubic interpolation, or bilinear without cubic_interpolation.
+// `image_j` (CV_32F) must outlive the cost function, which keeps its
+// address; it is read by cubic interpolation, or bilinear without
+// cubic_interpolation.
 ceres::CostFunction* NewPhotometricCost(const PhotometricSample& sample, const cv::Mat& image_j,
                                         bool shared_intrinsics, bool free_surface = false,
                                         bool cubic_interpolation = true);
