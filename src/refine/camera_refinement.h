@@ -122,7 +122,7 @@ struct CameraRefinementOptions {
   // Where they would take more than this, every pair gets fewer
   // (SamplesPerPair). 1024 holds 892,000 samples on a mesh of 750,000
   // faces: 60 views of 1280x960 in 258 ordered pairs (774,000) are not cut;
-  // at 435 a pair they still met the targets of docs/camera_refinement.md.
+  // at 368 a pair they still met the targets of docs/camera_refinement.md.
   int max_problem_mb = 1024;
 
   bool Check() const;
@@ -133,13 +133,14 @@ struct CameraRefinementOptions {
 // the residual blocks with their cost functions, the solve's Jacobian and
 // Schur elimination) and kProblemBytesPerFace per face of the mesh (its
 // plane offsets and its copy in the renderer). Fitted to the growth of the
-// in-use heap from before the samples were picked to the solve's peak in ten
-// rounds (the README's example: 162,000 samples on 160,000 faces; 60 views
-// of 1280x960: 112,000-774,000 samples on 747,000 faces), which it exceeds
-// in every one; a sample took 1,097-1,467 bytes of it, more where there were
-// fewer samples to share the mesh's part. Measured before the cost functions
-// kept their image by address instead of a 96-byte cv::Mat header (the test
-// scene's 48,000 samples: 40.8 -> 36.4 MB).
+// in-use heap from before the samples were picked to the solve's peak in
+// twelve rounds (the README's example: 162,000 samples on 160,000 faces; 60
+// views of 1280x960: 112,000-774,000 samples on 747,000 faces), which it
+// exceeds in every one; a sample took 1,097-1,467 bytes of it, more where
+// there were fewer samples to share the mesh's part. Measured before the
+// cost functions kept their image by address instead of a 96-byte cv::Mat
+// header (the test scene's 48,000 samples: 40.8 -> 36.4 MB); two rounds
+// since, with 94,944 samples, held 128 and 119 MB of a 150 MB budget.
 constexpr size_t kProblemBytesPerSample = 1150;
 constexpr size_t kProblemBytesPerFace = 64;
 
