@@ -152,6 +152,15 @@ class CameraRefinementTest : public ::testing::Test {
     return apply(scale);
   }
 
+  // The views 1 px off (PerturbPoses, seed 11), refined with `options` into
+  // *views.
+  CameraRefinementSummary RefineFromOnePixel(const CameraRefinementOptions& options,
+                                             std::vector<PinholeView>* views) {
+    const Scene& s = *scene_;
+    *views = PerturbPoses(1.0, 11, false);
+    return RefineCameras(s.images, s.pairs, s.V, s.F, renderer_, {}, options, views);
+  }
+
   // The mean camera centre and the mean distance of the centres to it.
   static void CameraSetGauge(const std::vector<PinholeView>& views, Eigen::Vector3d* mean,
                              double* scale) {
@@ -372,14 +381,12 @@ TEST_F(CameraRefinementTest, TruePosesStayTrue) {
 // Against the true mesh, held fixed (free face planes recover 0.150 px here:
 // they take information the exact mesh would give).
 TEST_F(CameraRefinementTest, RecoversPerturbedPoses) {
-  const Scene& s = *scene_;
-  std::vector<PinholeView> views = PerturbPoses(1.0, 11, false);
   double before_max = 0, after_max = 0;
-  const double before = ReprojectionRms(views, &before_max);
+  const double before = ReprojectionRms(PerturbPoses(1.0, 11, false), &before_max);
   CameraRefinementOptions options;
   options.surface_sigma_px = 0;
-  const CameraRefinementSummary summary =
-      RefineCameras(s.images, s.pairs, s.V, s.F, renderer_, {}, options, &views);
+  std::vector<PinholeView> views;
+  const CameraRefinementSummary summary = RefineFromOnePixel(options, &views);
   const double after = ReprojectionRms(views, &after_max);
   std::printf("%s\n", summary.BriefReport().c_str());
   std::printf("poses: reprojection RMS %.3f px (worst view %.3f) -> %.3f px (worst view %.3f)\n",
@@ -394,13 +401,11 @@ TEST_F(CameraRefinementTest, RecoversPerturbedPoses) {
 // and the refinement ends where it does with them.
 TEST_F(CameraRefinementTest, RendersInBatchesPickTheSameSamples) {
   const Scene& s = *scene_;
-  std::vector<PinholeView> at_once = PerturbPoses(1.0, 11, false), batched = at_once;
+  std::vector<PinholeView> at_once, batched;
   CameraRefinementOptions options;
-  const CameraRefinementSummary a =
-      RefineCameras(s.images, s.pairs, s.V, s.F, renderer_, {}, options, &at_once);
+  const CameraRefinementSummary a = RefineFromOnePixel(options, &at_once);
   options.max_render_mb = 1;
-  const CameraRefinementSummary b =
-      RefineCameras(s.images, s.pairs, s.V, s.F, renderer_, {}, options, &batched);
+  const CameraRefinementSummary b = RefineFromOnePixel(options, &batched);
   ASSERT_GT(s.pairs.size(), 4u);
   EXPECT_EQ(a.num_ordered_pairs, b.num_ordered_pairs);
   EXPECT_EQ(a.num_samples, b.num_samples);
@@ -418,16 +423,14 @@ TEST_F(CameraRefinementTest, RendersInBatchesPickTheSameSamples) {
 // against 0.185 px with free face planes on this mesh).
 TEST_F(CameraRefinementTest, ProblemBudgetCutsTheSamplesPerPair) {
   const Scene& s = *scene_;
-  std::vector<PinholeView> full = PerturbPoses(1.0, 11, false), cut = full;
+  std::vector<PinholeView> full, cut;
   CameraRefinementOptions options;
-  const CameraRefinementSummary a =
-      RefineCameras(s.images, s.pairs, s.V, s.F, renderer_, {}, options, &full);
+  const CameraRefinementSummary a = RefineFromOnePixel(options, &full);
   EXPECT_EQ(a.samples_per_pair, 3000);
   EXPECT_EQ(a.cut_to_fit_mb, 0);
   options.max_problem_mb = static_cast<int>((2 * s.pairs.size() * 600 * kProblemBytesPerSample +
                                               s.F.rows() * kProblemBytesPerFace) >> 20) + 1;
-  const CameraRefinementSummary b =
-      RefineCameras(s.images, s.pairs, s.V, s.F, renderer_, {}, options, &cut);
+  const CameraRefinementSummary b = RefineFromOnePixel(options, &cut);
   std::printf("%s\n%s\n", a.BriefReport().c_str(), b.BriefReport().c_str());
   const int per_pair = SamplesPerPair(options, 2 * s.pairs.size(), s.F.rows());
   EXPECT_EQ(b.samples_per_pair, per_pair);
