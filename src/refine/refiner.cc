@@ -788,18 +788,20 @@ std::string RefineSummary::FullReport() const {
       << " vertex moves reset), self-intersections left " << self_intersections << "\n";
   out << "  surface moved: mean " << mean_displacement << ", max " << max_displacement
       << " (scene units; distance of the result's vertices to the input surface)\n";
-  double data = 0, silhouette = 0, denoise = 0, cleanup = 0, iterating = 0;
+  double data = 0, silhouette = 0, denoise = 0, cleanup = 0, cameras = 0, iterating = 0;
   for (const auto& it : iterations) {
     data += it.data_seconds;
     silhouette += it.silhouette_seconds;
     denoise += it.denoise_seconds;
     cleanup += it.cleanup_seconds;
+    cameras += it.camera_seconds;
     iterating += it.seconds;
   }
   out << std::setprecision(3) << "  time: setup " << setup_seconds << " s, remeshing "
       << remesh_seconds << " s, iterations " << iterating << " s (data " << data
-      << ", silhouette " << silhouette << ", denoise " << denoise << ", clean-up " << cleanup
-      << "), final " << final_seconds << " s\n";
+      << ", silhouette " << silhouette << ", denoise " << denoise << ", clean-up " << cleanup;
+  if (cameras > 0) out << ", cameras " << cameras;
+  out << "), final " << final_seconds << " s\n";
   out << "  level iter  faces  similarity  kappa  step_px(mean/max)  regulariser  seconds\n";
   bool any_half = false;
   for (const auto& it : iterations) {
@@ -1137,8 +1139,10 @@ RefineSummary RefineMesh(const ViewSource& input_source, const RefineOptions& op
       // pulled off and the held-out photo-consistency fell from 0.625 to
       // 0.443 (0.612 finest only; docs/camera_refinement.md).
       if (std::find(camera_rounds.begin(), camera_rounds.end(), it) != camera_rounds.end()) {
+        const double t_cameras = ElapsedSeconds();
         RefineCamerasAtLevel(options, pairs, V, F, level, camera_of_view, renderer,
                              cache_bytes / 2, full_views, &images, &views, &cameras, &summary);
+        record.camera_seconds = ElapsedSeconds() - t_cameras;
         level_similarities.clear();  // measured through other cameras
         best_similarity = -std::numeric_limits<double>::infinity();
       }
@@ -1174,7 +1178,8 @@ RefineSummary RefineMesh(const ViewSource& input_source, const RefineOptions& op
       const DataTerm term = ComputeDataTerm(geometry, views, iteration_pairs, level, similarity,
                                             pair, &renders, &images,
                                             /*with_gradient=*/true, visit);
-      record.data_seconds = ElapsedSeconds() - t_iter - silhouette_seconds;
+      record.data_seconds =
+          ElapsedSeconds() - t_iter - record.camera_seconds - silhouette_seconds;
       record.mean_similarity = term.MeanSimilarity();
       if (initial_from_first_iteration && global_iteration == 0) {
         summary.initial_similarity = record.mean_similarity;
@@ -1330,8 +1335,11 @@ RefineSummary RefineMesh(const ViewSource& input_source, const RefineOptions& op
                    << "; " << record.seconds
                    << " s (data " << record.data_seconds << ", silhouette "
                    << record.silhouette_seconds << ", denoise " << record.denoise_seconds
-                   << ", clean-up " << record.cleanup_seconds << "; "
-                   << renders.num_renders() - renders_before << " renders); ETA "
+                   << ", clean-up " << record.cleanup_seconds
+                   << (record.camera_seconds > 0
+                           ? ", cameras " + FormatShort(record.camera_seconds, 3)
+                           : std::string())
+                   << "; " << renders.num_renders() - renders_before << " renders); ETA "
                    << FormatSeconds(eta);
       summary.iterations.push_back(record);
     }

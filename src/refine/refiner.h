@@ -314,9 +314,11 @@ struct RefineIteration {
   double max_step_px = 0;
   std::string regularizer_report;  // e.g. "p=0.5 theta=... sigma=... lambda=..."
   // Where the iteration's time went: renders and pair terms, the silhouette
-  // term, the proximal (denoising) step, and the clean-up (flipped faces and
-  // self-intersections undone).
+  // term, the proximal (denoising) step, the clean-up (flipped faces and
+  // self-intersections undone), and the camera refinement made before it
+  // (refine_cameras; 0 in the iterations without one).
   double data_seconds = 0, silhouette_seconds = 0, denoise_seconds = 0, cleanup_seconds = 0;
+  double camera_seconds = 0;
   double seconds = 0;
 };
 

@@ -802,6 +802,18 @@ TEST_F(RefinerTest, CameraRefinementUndoesPoseError) {
   std::printf("one camera round: pose error %.3f -> %.3f px, accuracy90 %.4f\n", error_before,
               error_one, Evaluate(once.V, once.F, V, F).accuracy90);
   EXPECT_LT(error_one, 0.4 * error_before) << one.camera_reports[0];
+  // The round's time is its own, not the data term's of the iteration it
+  // comes before.
+  ASSERT_EQ(CameraRoundIterations(options.iterations_per_level, 1), std::vector<int>{1});
+  ASSERT_GT(one.iterations.size(), 2u);
+  for (const RefineIteration& it : one.iterations) {
+    if (it.iteration == 1) {
+      EXPECT_GT(it.camera_seconds, 0);
+      EXPECT_LT(it.data_seconds + it.camera_seconds, it.seconds);
+    } else {
+      EXPECT_EQ(it.camera_seconds, 0) << it.iteration;
+    }
+  }
 
   // A memory budget smaller than the views' images (8 of 160 x 120, 600 KiB,
   // against half of a 1 MiB cache): the cameras are refined at pyramid level
