@@ -419,7 +419,7 @@ TEST_F(CameraRefinementTest, RendersInBatchesPickTheSameSamples) {
 
 // A problem budget below what 3,000 samples for every ordered pair take: each
 // pair gets at most SamplesPerPair samples (609 here), the report says so, and
-// the cameras are still recovered from 1 px, a little less closely (0.204
+// the cameras are still recovered from 1 px, a little less closely (0.203
 // against 0.185 px with free face planes on this mesh).
 TEST_F(CameraRefinementTest, ProblemBudgetCutsTheSamplesPerPair) {
   const Scene& s = *scene_;
