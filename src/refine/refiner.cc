@@ -1530,7 +1530,8 @@ void RegisterRefineOptions(OptionManager* o, RefineOptions* r) {
          "pixels sampled per ordered view pair (>= 1)");
   o->Add("CameraRefinement.max_problem_mb", &r->camera_refinement.max_problem_mb,
          "memory for the least-squares problem (MB, >= 1): where max_samples_per_pair for every "
-         "ordered pair would take more, each pair gets fewer (about 1.4 kB a sample)");
+         "ordered pair would take more, each pair gets fewer (counting 1,150 bytes a sample and "
+         "64 a mesh face)");
   o->Add("CameraRefinement.intensity_sigma", &r->camera_refinement.intensity_sigma,
          "1-sigma of an intensity residual, images in [0, 1]: the images' weight against the priors");
   o->Add("CameraRefinement.huber_delta", &r->camera_refinement.huber_delta,
