@@ -91,6 +91,13 @@ std::vector<PinholeView> LevelViews(const std::vector<PinholeView>& cameras, int
   return views;
 }
 
+// `value` with `digits` significant digits, for a log line.
+std::string FormatShort(double value, int digits = 3) {
+  std::ostringstream out;
+  out << std::setprecision(digits) << value;
+  return out.str();
+}
+
 // The bytes of the grey images (CV_32F) of `views`.
 size_t GrayBytes(const std::vector<PinholeView>& views) {
   size_t bytes = 0;
@@ -113,11 +120,7 @@ void RefineCamerasAtLevel(const RefineOptions& options,
                           ImageCache* images, std::vector<PinholeView>* views,
                           std::vector<PinholeView>* cameras, RefineSummary* summary) {
   const int camera_level = CameraRefinementLevel(*views, level, max_bytes);
-  const auto mib = [](size_t bytes) {
-    std::ostringstream out;
-    out << std::setprecision(3) << bytes / 1048576.0 << " MiB";
-    return out.str();
-  };
+  const auto mib = [](size_t bytes) { return FormatShort(bytes / 1048576.0) + " MiB"; };
   const std::string budget = mib(max_bytes) + " (half of --Refine.cache_mb)";
   if (camera_level < 0) {
     MR_LOG(INFO) << "Cameras not refined at level " << level << ": the images take "
@@ -382,13 +385,6 @@ DataTerm ComputeDataTerm(const MeshGeometry& mesh, const std::vector<PinholeView
     }
   }
   return accumulator.Sum();
-}
-
-// `value` with `digits` significant digits, for a log line.
-std::string FormatShort(double value, int digits = 3) {
-  std::ostringstream out;
-  out << std::setprecision(digits) << value;
-  return out.str();
 }
 
 // Mean plain-ZNCC similarity of all pairs at pyramid `level` through (V, F),
